@@ -1,0 +1,94 @@
+"""Per-frame observation groups (SPEC §4) and the frame stack, as batched torch."""
+
+from __future__ import annotations
+
+import torch
+
+OBS_MODES: dict[str, tuple[str, ...]] = {
+    "blind": ("tactile", "proprio"),
+    "state": ("tactile", "proprio", "privileged"),
+    "proprio": ("proprio",),
+}
+"""Observation mode -> groups, in the order they are concatenated."""
+
+JOINT_VELOCITY_SCALE = 1.0 / 3.0
+"""Joint velocities (rad/s) are multiplied by this in the proprio group (roto divides by 3)."""
+
+
+def tactile_bits(contact_force: torch.Tensor, threshold: float) -> torch.Tensor:
+    """Binary touch per link: 1 where the link's strongest contact pushes harder than ``threshold`` N.
+
+    Args:
+        contact_force: (B, n_links) normal force of each link's strongest contact (0 if none).
+
+    Returns:
+        (B, n_links) float32 in {0, 1}.
+    """
+    return (contact_force > threshold).to(torch.float32)
+
+
+def proprio_frame(
+    qpos: torch.Tensor,
+    qvel: torch.Tensor,
+    lo: torch.Tensor,
+    hi: torch.Tensor,
+    target: torch.Tensor,
+    actuated_qpos: torch.Tensor,
+    last_action: torch.Tensor,
+    velocity_scale: float = JOINT_VELOCITY_SCALE,
+) -> torch.Tensor:
+    """Proprioception: normalised positions, scaled velocities, command error, last action.
+
+    Args:
+        qpos: (B, n_obs) observed joint positions; qvel: (B, n_obs) their velocities.
+        lo, hi: (n_obs,) their limits.
+        target: (B, n_act) joint targets; actuated_qpos: (B, n_act) actuated joint positions.
+        last_action: (B, n_act) raw policy action of this step.
+
+    Returns:
+        (B, 2·n_obs + 2·n_act) float32.
+    """
+    pos = (2.0 * qpos - hi - lo) / (hi - lo)
+    return torch.cat([pos, qvel * velocity_scale, target - actuated_qpos, last_action.to(pos.dtype)], dim=-1).to(
+        torch.float32
+    )
+
+
+def privileged_frame(ball_pos: torch.Tensor, ball_vel: torch.Tensor) -> torch.Tensor:
+    """Object state: each ball's position (task frame, m) and linear velocity (m/s).
+
+    Args:
+        ball_pos, ball_vel: (B, n_ball, 3).
+
+    Returns:
+        (B, 6·n_ball) float32, per ball (x, y, z, vx, vy, vz).
+    """
+    return torch.cat([ball_pos, ball_vel], dim=-1).flatten(1).to(torch.float32)
+
+
+class FrameStack:
+    """The last k frames of each group, oldest -> newest, flattened to (B, k·dim) per group."""
+
+    def __init__(self, k: int) -> None:
+        if k < 1:
+            raise ValueError(f"frame stack k must be >= 1, got {k}")
+        self.k = k
+        self._frames: dict[str, torch.Tensor] = {}
+
+    def reset(self, frame: dict[str, torch.Tensor], env_ids: torch.Tensor | None = None) -> None:
+        """Fill the stack of ``env_ids`` (all if None) with k copies of ``frame`` ((n, dim) per group)."""
+        for name, value in frame.items():
+            copies = value[:, None, :].expand(-1, self.k, -1)
+            if env_ids is None:
+                self._frames[name] = copies.clone()
+            else:
+                self._frames[name][env_ids] = copies
+
+    def push(self, frame: dict[str, torch.Tensor]) -> None:
+        """Append one frame ((B, dim) per group), dropping the oldest."""
+        for name, value in frame.items():
+            self._frames[name] = torch.cat([self._frames[name][:, 1:], value[:, None, :]], dim=1)
+
+    def observation(self) -> dict[str, torch.Tensor]:
+        """(B, k·dim) per group; fresh tensors each step, never views of internal buffers."""
+        return {name: frames.flatten(1).clone() for name, frames in self._frames.items()}

@@ -1,0 +1,305 @@
+"""The batched roto environment: B worlds of one (task, robot) pair, torch in and out.
+
+One ``step`` runs, in this order (DESIGN §1):
+  action -> joint targets -> backend (substeps on B worlds) -> task counters, rewards,
+  terminations -> observation frame -> frame stack -> auto-reset of finished worlds (same step).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+import torch
+
+from roto.envs.config import EnvConfig
+from roto.envs.control import action_to_target, smooth_target
+from roto.envs.observations import OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
+from roto.robots import get_robot
+from roto.robots.spec import RobotSpec
+from roto.sim.mujoco_cpu import MujocoCpuBackend
+from roto.sim.scene import SceneLayout, build_scene
+from roto.tasks import get_task
+from roto.tasks.base import TaskInputs, uniform
+
+
+@dataclass
+class _Episode:
+    """Running per-env episode statistics, each (B,)."""
+
+    length: torch.Tensor  # int64 control steps so far
+    ret: torch.Tensor  # float64 return so far
+
+
+class RotoEnv:
+    """B parallel worlds of one roto task on one robot (see ``roto.make``)."""
+
+    metadata: ClassVar[dict[str, Any]] = {"autoreset_mode": gym.vector.AutoresetMode.SAME_STEP}
+
+    def __init__(self, config: EnvConfig) -> None:
+        self.config = config
+        self.task = get_task(config.task)
+        self.robot: RobotSpec = get_robot(config.robot)
+        self.num_envs = config.num_envs
+        self.device = torch.device(config.device)
+        self.groups = OBS_MODES[config.obs_mode]
+        self.balls = self.task.balls(self.robot)
+        self.model, self.layout = build_scene(self.robot, self.balls)
+        self.backend = MujocoCpuBackend(self.model, config.num_envs, substeps=config.substeps, threads=config.threads)
+        self._generator = torch.Generator(device=self.device)
+        self._generator.manual_seed(config.seed)
+        self._idx = _Indices.from_layout(self.layout, self.robot, self.model, self.device)
+        self.num_actions = self.robot.num_actions
+        self.task_state = self.task.init_state(self.robot, self.num_envs, self.device)
+        self._stack = FrameStack(config.frame_stack)
+        self._episode = _Episode(
+            length=torch.zeros(self.num_envs, dtype=torch.int64, device=self.device),
+            ret=torch.zeros(self.num_envs, dtype=torch.float64, device=self.device),
+        )
+        self._target = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
+        self._last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
+        self._term_sums: dict[str, torch.Tensor] = {}
+        self.nonfinite_resets = 0
+        self._needs_reset = True
+        self.frame_sizes = self._frame_sizes()
+        self.observation_space = gym.spaces.Dict(
+            {
+                name: gym.spaces.Box(-np.inf, np.inf, (config.frame_stack * size,), np.float32)
+                for name, size in self.frame_sizes.items()
+            }
+        )
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (self.num_actions,), np.float32)
+
+    # ------------------------------------------------------------------ public API
+
+    def reset(self, seed: int | None = None) -> tuple[dict[str, torch.Tensor], dict[str, Any]]:
+        """Reset every world; returns (obs, info). ``seed`` re-seeds the reset noise."""
+        if seed is not None:
+            self._generator.manual_seed(int(seed))
+        all_ids = torch.arange(self.num_envs, device=self.device)
+        frame = self._reset_worlds(all_ids)
+        self._stack.reset(frame)
+        self._needs_reset = False
+        return self._stack.observation(), {}
+
+    def step(
+        self, action: torch.Tensor
+    ) -> tuple[dict[str, torch.Tensor], torch.Tensor, torch.Tensor, torch.Tensor, dict[str, Any]]:
+        """Advance every world one control step; finished worlds are reset within the same step.
+
+        Returns (obs, reward (B,), terminated (B,), truncated (B,), info). For worlds that finished,
+        ``info["final_obs"]`` holds their last observation, ``info["episode"]`` their return ``r``,
+        length ``l``, task metrics and ``time_out`` (valid where ``info["_episode"]`` is True).
+        """
+        if self._needs_reset:
+            raise RuntimeError("call reset() before the first step()")
+        action = self._check_action(action)
+        target = action_to_target(action.to(torch.float64), self._idx.ctrl_lo, self._idx.ctrl_hi)
+        self._target = smooth_target(target, self._target, self.config.action_smoothing)
+        self._last_action = action.to(torch.float32, copy=True)  # never alias the caller's tensor
+
+        sim = self.backend.step(self._target)
+        qpos = sim.qpos.to(self.device)
+        qvel = sim.qvel.to(self.device)
+        sensors = sim.sensordata.to(self.device)
+        diverged = sim.diverged.to(self.device)
+
+        inputs = self._task_inputs(qpos, qvel, sensors)
+        result = self.task.step(self.task_state, inputs)
+        reward = sum(result.reward_terms.values())
+        reward = torch.where(diverged, torch.zeros_like(reward), reward)
+        self._episode.length += 1
+        self._episode.ret += reward
+        for name, value in result.reward_terms.items():
+            self._term_sums.setdefault(name, torch.zeros_like(value))
+            self._term_sums[name] += value
+        terminated = result.terminated | diverged
+        truncated = (self._episode.length >= self.config.episode_steps) & ~terminated
+
+        frame = self._frame(qpos, qvel, sensors[:, -1], inputs, self._target, self._last_action)
+        frame = {k: torch.nan_to_num(v, nan=0.0, posinf=0.0, neginf=0.0) for k, v in frame.items()}
+        self._stack.push(frame)
+        obs = self._stack.observation()
+
+        done = terminated | truncated
+        info: dict[str, Any] = {"reward_terms": result.reward_terms, "nonfinite": diverged}
+        if bool(done.any()):
+            info["final_obs"] = obs
+            info["_final_obs"] = done
+            info["episode"] = self._episode_info(truncated)
+            info["_episode"] = done
+            self.nonfinite_resets += int(diverged.sum())
+            done_ids = torch.nonzero(done).flatten()
+            self._stack.reset(self._reset_worlds(done_ids), done_ids)
+            obs = self._stack.observation()
+        return obs, reward.to(torch.float32), terminated, truncated, info
+
+    def close(self) -> None:
+        """Release the backend's threads."""
+        self.backend.close()
+
+    @property
+    def unwrapped(self) -> RotoEnv:
+        """This env (Gymnasium-style accessor)."""
+        return self
+
+    # ------------------------------------------------------------------ internals
+
+    def _frame_sizes(self) -> dict[str, int]:
+        n_obs, n_act = len(self.robot.observed_joints), self.num_actions
+        sizes = {
+            "tactile": len(self.robot.tactile_links),
+            "proprio": 2 * n_obs + 2 * n_act,
+            "privileged": 6 * len(self.balls),
+        }
+        return {group: sizes[group] for group in self.groups}
+
+    def _check_action(self, action: Any) -> torch.Tensor:
+        expected = (self.num_envs, self.num_actions)
+        if not isinstance(action, torch.Tensor):
+            raise TypeError(f"action must be a torch.Tensor of shape {expected}, got {type(action).__name__}")
+        if tuple(action.shape) != expected:
+            raise ValueError(
+                f"action shape {tuple(action.shape)} is wrong; expected (num_envs, num_actions) = {expected}"
+            )
+        if not action.is_floating_point():
+            raise TypeError(f"action dtype {action.dtype} is not floating point; use torch.float32 or torch.float64")
+        if action.device != self.device:
+            raise ValueError(f"action is on device {action.device}; this env runs on {self.device}")
+        if not bool(torch.isfinite(action).all()):
+            bad = torch.nonzero(~torch.isfinite(action).all(dim=1)).flatten().tolist()
+            raise ValueError(f"action has non-finite values (NaN or inf) in envs {bad[:10]}; actions must be finite")
+        return action
+
+    def _task_inputs(self, qpos: torch.Tensor, qvel: torch.Tensor, sensors: torch.Tensor) -> TaskInputs:
+        idx = self._idx
+        ball_pos = qpos[:, idx.ball_pos]
+        ball_vel = qvel[:, idx.ball_vel]
+        contact = (sensors[:, :, idx.ball_force] > self.config.tactile_threshold).any(dim=1)
+        return TaskInputs(ball_pos=ball_pos, ball_vel=ball_vel, ball_contact=contact)
+
+    def _frame(
+        self,
+        qpos: torch.Tensor,
+        qvel: torch.Tensor,
+        sensors_now: torch.Tensor,
+        inputs: TaskInputs,
+        target: torch.Tensor,
+        last_action: torch.Tensor,
+    ) -> dict[str, torch.Tensor]:
+        """One observation frame per group from (n, ·) state tensors."""
+        idx = self._idx
+        groups: dict[str, torch.Tensor] = {}
+        if "tactile" in self.groups:
+            groups["tactile"] = tactile_bits(sensors_now[:, idx.tactile_force], self.config.tactile_threshold)
+        groups["proprio"] = proprio_frame(
+            qpos[:, idx.obs_qpos],
+            qvel[:, idx.obs_qvel],
+            idx.obs_lo,
+            idx.obs_hi,
+            target,
+            qpos[:, idx.act_qpos],
+            last_action,
+        )
+        if "privileged" in self.groups:
+            groups["privileged"] = privileged_frame(inputs.ball_pos, inputs.ball_vel)
+        return {name: groups[name] for name in self.groups}
+
+    def _reset_worlds(self, env_ids: torch.Tensor) -> dict[str, torch.Tensor]:
+        """Reset worlds ``env_ids``: hand at default pose + noise, task objects placed; their first frame."""
+        n = len(env_ids)
+        idx = self._idx
+        qpos = idx.default_qpos.expand(n, -1).clone()
+        noise = uniform(self._generator, (n, len(idx.act_qpos)), self.config.reset_joint_noise, self.device)
+        qpos[:, idx.act_qpos] = torch.clamp(qpos[:, idx.act_qpos] + noise, idx.ctrl_lo, idx.ctrl_hi)
+        qpos[:, idx.coupled_driven] = torch.clamp(
+            qpos[:, idx.coupled_driver] * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi
+        )
+        ball_pos = self.task.reset(self.task_state, env_ids, self._generator)
+        qpos[:, idx.ball_pos] = ball_pos.to(qpos.dtype)
+        qpos[:, idx.ball_quat] = idx.identity_quat
+        qvel = torch.zeros(n, self.model.nv, dtype=torch.float64, device=self.device)
+        target = qpos[:, idx.act_qpos]
+        sensors = self.backend.set_state(env_ids.cpu(), qpos.cpu(), qvel.cpu(), target.cpu()).to(self.device)
+
+        self._target[env_ids] = target
+        self._last_action[env_ids] = 0.0
+        self._episode.length[env_ids] = 0
+        self._episode.ret[env_ids] = 0.0
+        for value in self._term_sums.values():
+            value[env_ids] = 0.0
+        inputs = TaskInputs(ball_pos=qpos[:, idx.ball_pos], ball_vel=qvel[:, idx.ball_vel], ball_contact=torch.zeros(0))
+        return self._frame(qpos, qvel, sensors, inputs, target, self._last_action[env_ids])
+
+    def _episode_info(self, truncated: torch.Tensor) -> dict[str, torch.Tensor]:
+        info = {
+            "r": self._episode.ret.to(torch.float32).clone(),
+            "l": self._episode.length.clone(),
+            "time_out": truncated.clone(),
+        }
+        info.update({k: v.clone() for k, v in self.task.metrics(self.task_state).items()})
+        info.update({f"reward/{k}": v.to(torch.float32).clone() for k, v in self._term_sums.items()})
+        return info
+
+
+@dataclass(frozen=True)
+class _Indices:
+    """Index tensors into qpos / qvel / sensordata, on the env's device."""
+
+    act_qpos: torch.Tensor
+    obs_qpos: torch.Tensor
+    obs_qvel: torch.Tensor
+    obs_lo: torch.Tensor
+    obs_hi: torch.Tensor
+    ctrl_lo: torch.Tensor
+    ctrl_hi: torch.Tensor
+    ball_pos: torch.Tensor  # (n_ball, 3) qpos indices of each ball's centre
+    ball_quat: torch.Tensor  # (n_ball, 4)
+    ball_vel: torch.Tensor  # (n_ball, 3) qvel indices of each ball's linear velocity
+    tactile_force: torch.Tensor  # (n_links,) sensordata index of each link's normal force
+    ball_force: torch.Tensor  # (n_ball,) sensordata index of each ball-hand normal force
+    default_qpos: torch.Tensor  # (1, nq)
+    identity_quat: torch.Tensor  # (4,)
+    coupled_driven: torch.Tensor
+    coupled_driver: torch.Tensor
+    coupled_ratio: torch.Tensor
+    coupled_lo: torch.Tensor
+    coupled_hi: torch.Tensor
+
+    @classmethod
+    def from_layout(cls, layout: SceneLayout, robot: RobotSpec, model: Any, device: torch.device) -> _Indices:
+        def t(array: Any, dtype: torch.dtype = torch.int64) -> torch.Tensor:
+            return torch.as_tensor(np.asarray(array), dtype=dtype, device=device)
+
+        f64 = torch.float64
+        driven = [model.joint(j).qposadr[0] for j in robot.coupled_joints]
+        driver = [model.joint(d).qposadr[0] for d, _ in robot.coupled_joints.values()]
+        driven_ids = [model.joint(j).id for j in robot.coupled_joints]
+        default = layout.default_qpos.copy()
+        for j, (d, ratio) in robot.coupled_joints.items():
+            default[model.joint(j).qposadr[0]] = np.clip(
+                ratio * default[model.joint(d).qposadr[0]], *model.jnt_range[model.joint(j).id]
+            )
+        return cls(
+            act_qpos=t(layout.act_qpos),
+            obs_qpos=t(layout.obs_qpos),
+            obs_qvel=t(layout.obs_qvel),
+            obs_lo=t(layout.obs_lo, f64),
+            obs_hi=t(layout.obs_hi, f64),
+            ctrl_lo=t(layout.ctrl_lo, f64),
+            ctrl_hi=t(layout.ctrl_hi, f64),
+            ball_pos=t(layout.ball_qpos[:, None] + np.arange(3)),
+            ball_quat=t(layout.ball_qpos[:, None] + 3 + np.arange(4)),
+            ball_vel=t(layout.ball_qvel[:, None] + np.arange(3)),
+            tactile_force=t(layout.tactile_sensor + 1),
+            ball_force=t(layout.ball_contact_sensor + 1),
+            default_qpos=t(default, f64)[None],
+            identity_quat=t([1.0, 0.0, 0.0, 0.0], f64),
+            coupled_driven=t(driven),
+            coupled_driver=t(driver),
+            coupled_ratio=t([r for _, r in robot.coupled_joints.values()], f64),
+            coupled_lo=t(model.jnt_range[driven_ids, 0] if driven_ids else [], f64),
+            coupled_hi=t(model.jnt_range[driven_ids, 1] if driven_ids else [], f64),
+        )

@@ -1,0 +1,76 @@
+"""The robot record: everything a task or a backend needs to know about one hand, as data."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import mujoco
+
+
+@dataclass(frozen=True, kw_only=True)
+class Gains:
+    """Position-actuator gains for a group of joints (damping lives inside the actuator).
+
+    Attributes:
+        kp: proportional gain, N·m/rad.
+        kv: derivative gain, N·m·s/rad (clamped by the actuator's force limit, as in PhysX).
+    """
+
+    kp: float
+    kv: float
+
+
+@dataclass(frozen=True, kw_only=True)
+class RobotSpec:
+    """One hand, described as data.
+
+    Attributes:
+        name: registry name (lower case, e.g. ``"shadow"``).
+        display_name: name used in Gymnasium ids (e.g. ``"Shadow"``).
+        load_spec: returns a fresh ``mujoco.MjSpec`` of the hand alone (no world, no objects).
+        root_body: the body that carries the whole hand; it is re-posed into the task frame.
+        actuated_joints: joint names in action order; each has one position actuator.
+        observed_joints: joint names whose position and velocity are observed, in order.
+        tactile_links: body names that each give one tactile bit, in observation order.
+        gains: joint-name prefix/suffix pattern -> gains; first matching key wins (see ``gains_for``).
+        default_pose: joint name -> angle (rad) of the cupped resting pose; missing joints are 0.
+        palm_geom: the collision geom whose top face is the palm surface.
+        knuckle_bodies: finger base bodies, index finger first and little (or last) finger last.
+        tip_bodies: distal finger bodies, used to find the finger direction.
+        baoding_ball_radius: Baoding ball radius for this hand (m).
+        baoding_targets: T_a and T_b (task frame, m), calibrated where two balls really rest in
+            the default pose (``roto.tasks.baoding.calibrate_targets``; a test re-checks them).
+        coupled_joints: driven joint -> (driving joint, ratio): the model couples them (tendon or
+            equality); resets set driven = ratio * driving so no coupling starts violated.
+        excluded_contacts: body pairs whose contacts are filtered out.
+    """
+
+    name: str
+    display_name: str
+    load_spec: Callable[[], mujoco.MjSpec]
+    root_body: str
+    actuated_joints: tuple[str, ...]
+    observed_joints: tuple[str, ...]
+    tactile_links: tuple[str, ...]
+    gains: Mapping[str, Gains]
+    default_pose: Mapping[str, float]
+    palm_geom: str
+    knuckle_bodies: tuple[str, ...]
+    tip_bodies: tuple[str, ...]
+    baoding_ball_radius: float
+    baoding_targets: tuple[tuple[float, float, float], tuple[float, float, float]]
+    coupled_joints: Mapping[str, tuple[str, float]] = field(default_factory=dict)
+    excluded_contacts: tuple[tuple[str, str], ...] = field(default=())
+
+    def gains_for(self, joint: str) -> Gains:
+        """The gains of one actuated joint: the first key of ``gains`` contained in its name."""
+        for key, gains in self.gains.items():
+            if key in joint:
+                return gains
+        raise KeyError(f"robot {self.name!r}: no gains for joint {joint!r}; keys are {list(self.gains)}")
+
+    @property
+    def num_actions(self) -> int:
+        """Action dimension (one per actuated joint)."""
+        return len(self.actuated_joints)

@@ -1,0 +1,125 @@
+"""CPU backend: B MuJoCo worlds stepped in C threads by a persistent ``mujoco.rollout`` pool.
+
+The full physics state of every world lives in one float64 array ``(B, nstate)``. A control step
+is a single ``rollout`` call over all B worlds (the GIL is released; no per-world Python), after
+which the last substep's state becomes the new state. Warm-start accelerations are zeroed at every
+call, as ``rollout`` does, which keeps results independent of how worlds are spread over threads.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import torch
+from mujoco import rollout
+
+from roto.sim.backend import SimState
+
+_FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
+_CTRL = mujoco.mjtState.mjSTATE_CTRL.value
+
+
+def state_offsets(model: mujoco.MjModel) -> tuple[int, int]:
+    """Offsets of qpos and qvel inside a ``mjSTATE_FULLPHYSICS`` vector."""
+    time = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_TIME.value)
+    qpos = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_QPOS.value)
+    return time, time + qpos
+
+
+class MujocoCpuBackend:
+    """B worlds of ``model`` on the CPU, ``threads`` C threads (1 = the calling thread)."""
+
+    def __init__(self, model: mujoco.MjModel, num_worlds: int, *, substeps: int, threads: int = 1) -> None:
+        if threads < 1:
+            raise ValueError(f"threads must be >= 1, got {threads}")
+        self.model = model
+        self.num_worlds = num_worlds
+        self.substeps = substeps
+        self.threads = threads
+        self.device = torch.device("cpu")
+        self._datas = [mujoco.MjData(model) for _ in range(threads)]
+        self._models = [model] * num_worlds
+        self._pool = rollout.Rollout(nthread=threads if threads > 1 else 0)
+        self._nstate = mujoco.mj_stateSize(model, _FULL)
+        self._qpos0, self._qvel0 = state_offsets(model)
+        self.state = np.zeros((num_worlds, self._nstate))
+        data = mujoco.MjData(model)
+        mujoco.mj_getState(model, data, self.state[0], _FULL)
+        self.state[:] = self.state[0]
+        self._ctrl = np.zeros((num_worlds, substeps, model.nu))
+        self._out_state = np.zeros((num_worlds, substeps, self._nstate))
+        self._out_sensor = np.zeros((num_worlds, substeps, model.nsensordata))
+        self._chunk = max(1, num_worlds // (threads * 10))
+
+    @property
+    def qpos(self) -> np.ndarray:
+        """(B, nq) view of the current joint positions."""
+        return self.state[:, self._qpos0 : self._qpos0 + self.model.nq]
+
+    @property
+    def qvel(self) -> np.ndarray:
+        """(B, nv) view of the current joint velocities."""
+        return self.state[:, self._qvel0 : self._qvel0 + self.model.nv]
+
+    def step(self, ctrl: torch.Tensor) -> SimState:
+        """Hold ``ctrl`` (B, nu) for ``substeps`` physics steps on every world, in C threads."""
+        self._ctrl[:] = ctrl.detach().to(torch.float64).numpy()[:, None, :]
+        self._pool.rollout(
+            self._models,
+            self._datas,
+            self.state,
+            self._ctrl,
+            control_spec=_CTRL,
+            skip_checks=True,
+            nstep=self.substeps,
+            state=self._out_state,
+            sensordata=self._out_sensor,
+            chunk_size=self._chunk,
+        )
+        expected_time = self.state[:, 0] + (self.substeps - 0.5) * self.model.opt.timestep
+        self.state[:] = self._out_state[:, -1]
+        # MuJoCo resets a world whose qpos/qvel/qacc go non-finite or huge (time restarts at 0),
+        # and rollout stops stepping it; a clock that fell behind is how that shows.
+        diverged = (self.state[:, 0] < expected_time) | ~np.isfinite(self.state).all(axis=1)
+        return SimState(
+            qpos=torch.from_numpy(self.qpos),
+            qvel=torch.from_numpy(self.qvel),
+            sensordata=torch.from_numpy(self._out_sensor),
+            diverged=torch.from_numpy(diverged),
+        )
+
+    def set_state(
+        self, world_ids: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor
+    ) -> torch.Tensor:
+        """Overwrite worlds ``world_ids`` (n,) with ``qpos`` (n, nq), ``qvel`` (n, nv), time 0.
+
+        Returns their sensordata (n, nsensordata) evaluated at the new state under ``ctrl`` (n, nu)
+        (one throw-away physics step computes it; its resulting state is discarded).
+        """
+        ids = world_ids.numpy()
+        self.state[ids, 0] = 0.0
+        self.state[ids, self._qpos0 : self._qpos0 + self.model.nq] = qpos.to(torch.float64).numpy()
+        self.state[ids, self._qvel0 : self._qvel0 + self.model.nv] = qvel.to(torch.float64).numpy()
+        n = len(ids)
+        if n == 0:
+            return torch.zeros((0, self.model.nsensordata), dtype=torch.float64)
+        sensors = np.zeros((n, 1, self.model.nsensordata))
+        self._pool.rollout(
+            self._models[:n],
+            self._datas,
+            np.ascontiguousarray(self.state[ids]),
+            np.ascontiguousarray(ctrl.to(torch.float64).numpy()[:, None, :]),
+            control_spec=_CTRL,
+            skip_checks=True,
+            nstep=1,
+            state=np.zeros((n, 1, self._nstate)),
+            sensordata=sensors,
+            chunk_size=max(1, n // (self.threads * 10)),
+        )
+        return torch.from_numpy(sensors[:, 0])
+
+    def close(self) -> None:
+        """Stop the thread pool."""
+        if self._pool is not None:
+            self._pool.close()
+            self._pool = None

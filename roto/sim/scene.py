@@ -1,0 +1,149 @@
+"""Compose a hand and a task's balls into one MuJoCo model, and index what the env reads.
+
+The model holds, besides the hand, one free-floating sphere per ball and two kinds of
+``contact`` sensors (MuJoCo 4's exact per-body contact sensors):
+
+* one per tactile link: ``body1 = link``, any partner, data ``found force`` reduced to the
+  strongest contact, so the first force component is that contact's normal force;
+* one per ball: ``body1 = ball``, ``subtree2 = hand root`` (hand contact only, not ball-ball).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from roto.robots.mjspec_tools import build_hand
+from roto.robots.spec import RobotSpec
+
+PHYSICS_DT = 1.0 / 240.0
+"""Physics timestep (s), SPEC §1."""
+
+_FOUND, _FORCE = 1, 2
+_REDUCE_MAXFORCE = 2
+CONTACT_SENSOR_DIM = 4
+"""Values per contact sensor: (number of contacts found, force in the contact frame (3,))."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class BallSpec:
+    """A free sphere in the scene (radius m, mass kg, sliding friction)."""
+
+    name: str
+    radius: float
+    mass: float
+    friction: float = 1.0
+    rgba: tuple[float, float, float, float] = (0.9, 0.3, 0.2, 1.0)
+
+
+@dataclass(frozen=True, kw_only=True)
+class SceneLayout:
+    """Where each quantity the env needs lives in qpos / qvel / ctrl / sensordata.
+
+    All index arrays are int64 numpy arrays; lengths are given in brackets.
+    """
+
+    act_qpos: np.ndarray  # [n_act] qpos address of each actuated joint (action order)
+    obs_qpos: np.ndarray  # [n_obs] qpos address of each observed joint
+    obs_qvel: np.ndarray  # [n_obs] dof address of each observed joint
+    obs_lo: np.ndarray  # [n_obs] lower limit of each observed joint
+    obs_hi: np.ndarray  # [n_obs] upper limit
+    ctrl_lo: np.ndarray  # [n_act] lower joint limit of each actuated joint (= actuator ctrlrange)
+    ctrl_hi: np.ndarray  # [n_act] upper joint limit
+    ball_qpos: np.ndarray  # [n_ball] qpos address of each ball's free joint (position xyz, quat wxyz)
+    ball_qvel: np.ndarray  # [n_ball] dof address of each ball's free joint (linear xyz, angular xyz)
+    tactile_sensor: np.ndarray  # [n_tactile] sensordata address of each link's contact sensor
+    ball_contact_sensor: np.ndarray  # [n_ball] sensordata address of each ball-hand contact sensor
+    default_qpos: np.ndarray  # [nq] hand at its default pose, balls at the origin (placed by the task)
+    hand_qpos: np.ndarray  # [n_hand_q] qpos addresses of every hand joint
+
+
+def _add_contact_sensor(spec: mujoco.MjSpec, name: str, body: str, subtree2: str | None = None) -> None:
+    sensor = spec.add_sensor()
+    sensor.name = name
+    sensor.type = mujoco.mjtSensor.mjSENS_CONTACT
+    sensor.objtype = mujoco.mjtObj.mjOBJ_BODY
+    sensor.objname = body
+    if subtree2 is not None:
+        sensor.reftype = mujoco.mjtObj.mjOBJ_XBODY
+        sensor.refname = subtree2
+    sensor.intprm = np.array([_FOUND | _FORCE, _REDUCE_MAXFORCE, 1] + [0] * (len(sensor.intprm) - 3))
+
+
+def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...]) -> mujoco.MjSpec:
+    """The hand (posed in the task frame) plus the balls and roto's sensors, as an MjSpec."""
+    spec = build_hand(robot)
+    spec.modelname = f"roto_{robot.name}_{len(balls)}balls"
+    spec.option.timestep = PHYSICS_DT
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.gravity = np.array([0.0, 0.0, -9.81])
+    for ball in balls:
+        body = spec.worldbody.add_body(name=ball.name, pos=[0.0, 0.0, 0.3])
+        body.add_freejoint(name=f"{ball.name}_free")
+        body.add_geom(
+            name=f"{ball.name}_geom",
+            type=mujoco.mjtGeom.mjGEOM_SPHERE,
+            size=[ball.radius, 0.0, 0.0],
+            mass=ball.mass,
+            friction=[ball.friction, 0.005, 0.0001],
+            contype=1,
+            conaffinity=1,
+            condim=3,
+            rgba=list(ball.rgba),
+        )
+    for link in robot.tactile_links:
+        _add_contact_sensor(spec, f"touch_{link}", link)
+    for ball in balls:
+        _add_contact_sensor(spec, f"hand_contact_{ball.name}", ball.name, subtree2=robot.root_body)
+    return spec
+
+
+def scene_layout(model: mujoco.MjModel, robot: RobotSpec, balls: tuple[BallSpec, ...]) -> SceneLayout:
+    """Index the compiled scene (see ``SceneLayout``)."""
+
+    def joint_ids(names: tuple[str, ...]) -> np.ndarray:
+        return np.array([model.joint(n).id for n in names], dtype=np.int64)
+
+    act = joint_ids(robot.actuated_joints)
+    obs = joint_ids(robot.observed_joints)
+    ball_joints = np.array([model.joint(f"{b.name}_free").id for b in balls], dtype=np.int64)
+    ball_ids = {model.joint(j).id for j in (f"{b.name}_free" for b in balls)}
+    hand_joints = np.array([j for j in range(model.njnt) if j not in ball_ids], dtype=np.int64)
+    for name in robot.actuated_joints:
+        actuator_joint = [model.actuator_trnid[i, 0] for i in range(model.nu)]
+        if model.joint(name).id not in actuator_joint:
+            raise ValueError(f"robot {robot.name!r}: joint {name!r} has no actuator")
+    act_order = [int(np.flatnonzero(model.actuator_trnid[:, 0] == j)[0]) for j in act]
+    if act_order != list(range(model.nu)):
+        raise ValueError(f"robot {robot.name!r}: actuator order must follow actuated_joints, got {act_order}")
+
+    default_qpos = model.qpos0.copy()
+    for joint, angle in robot.default_pose.items():
+        default_qpos[model.joint(joint).qposadr[0]] = angle
+
+    def sensor_adr(name: str) -> int:
+        return int(model.sensor_adr[model.sensor(name).id])
+
+    return SceneLayout(
+        act_qpos=model.jnt_qposadr[act].astype(np.int64),
+        obs_qpos=model.jnt_qposadr[obs].astype(np.int64),
+        obs_qvel=model.jnt_dofadr[obs].astype(np.int64),
+        obs_lo=model.jnt_range[obs, 0].copy(),
+        obs_hi=model.jnt_range[obs, 1].copy(),
+        ctrl_lo=model.jnt_range[act, 0].copy(),
+        ctrl_hi=model.jnt_range[act, 1].copy(),
+        ball_qpos=model.jnt_qposadr[ball_joints].astype(np.int64),
+        ball_qvel=model.jnt_dofadr[ball_joints].astype(np.int64),
+        tactile_sensor=np.array([sensor_adr(f"touch_{link}") for link in robot.tactile_links], dtype=np.int64),
+        ball_contact_sensor=np.array([sensor_adr(f"hand_contact_{b.name}") for b in balls], dtype=np.int64),
+        default_qpos=default_qpos,
+        hand_qpos=model.jnt_qposadr[hand_joints].astype(np.int64),
+    )
+
+
+def build_scene(robot: RobotSpec, balls: tuple[BallSpec, ...]) -> tuple[mujoco.MjModel, SceneLayout]:
+    """Compile the scene and index it."""
+    model = build_scene_spec(robot, balls).compile()
+    return model, scene_layout(model, robot, balls)

@@ -1,0 +1,140 @@
+"""Baoding: rotate two balls around each other in the hand as often as possible in 10 s (SPEC §6)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+import torch
+
+from roto.robots.spec import RobotSpec
+from roto.sim.scene import BallSpec, build_scene
+from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, uniform
+
+BALL_MASS = 0.055
+SUCCESS_RADIUS = 0.01
+"""A ball within this distance of its current target sets its latch (m)."""
+SWAP_REWARD = 10.0
+DENSE_SCALE = 0.1
+DENSE_LENGTH = 0.1
+"""Dense reward 0.1 · Σ (1 − tanh(d / 0.1)) per step."""
+MAX_SEPARATION = 0.15
+"""Balls this far apart end the episode (m)."""
+RESET_NOISE = 0.005
+"""Half-width of the shared uniform offset of both balls at reset (m)."""
+CALIBRATION_DIAGONAL = (1.0 / np.sqrt(2.0), -1.0 / np.sqrt(2.0), 0.0)
+"""Palm diagonal (towards the fingers and the thumb) along which the second ball is placed."""
+
+
+def baoding_balls(radius: float) -> tuple[BallSpec, ...]:
+    """Two 55 g balls of the given radius (distinct colours)."""
+    return (
+        BallSpec(name="ball_a", radius=radius, mass=BALL_MASS, rgba=(0.85, 0.65, 0.15, 1.0)),
+        BallSpec(name="ball_b", radius=radius, mass=BALL_MASS, rgba=(0.2, 0.45, 0.85, 1.0)),
+    )
+
+
+def calibrate_targets(robot: RobotSpec, settle_steps: int = 900, substeps: int = 4) -> np.ndarray:
+    """Where two balls really rest in ``robot``'s default pose: targets (2, 3) in the task frame.
+
+    Ball a is dropped just above the palm centre, ball b one diameter + 1.7 mm away along the
+    palm diagonal ``CALIBRATION_DIAGONAL``; the hand holds its default pose and both settle for
+    ``settle_steps`` control steps. T_a and T_b are where they come to rest.
+    """
+    radius = robot.baoding_ball_radius
+    model, layout = build_scene(robot, baoding_balls(radius))
+    data = mujoco.MjData(model)
+    data.qpos[:] = layout.default_qpos
+    start_a = np.array([0.0, 0.0, radius + 0.005])
+    start_b = start_a + (2 * radius + 0.0017) * np.array(CALIBRATION_DIAGONAL)
+    for adr, start in zip(layout.ball_qpos, (start_a, start_b), strict=True):
+        data.qpos[adr : adr + 3] = start
+    data.ctrl[:] = layout.default_qpos[layout.act_qpos]
+    mujoco.mj_step(model, data, nstep=settle_steps * substeps)
+    return np.stack([data.qpos[adr : adr + 3].copy() for adr in layout.ball_qpos])
+
+
+@dataclass
+class BaodingState:
+    """Per-env task state."""
+
+    targets: torch.Tensor  # (2, 3) T_a, T_b, shared by all envs
+    swapped: torch.Tensor  # (B,) bool: ball a aims at T_b and ball b at T_a
+    latched: torch.Tensor  # (B, 2) bool: ball i has reached its current target
+    swaps: torch.Tensor  # (B,) int64
+
+
+def baoding_rule(
+    ball_pos: torch.Tensor, targets: torch.Tensor, swapped: torch.Tensor, latched: torch.Tensor
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """One step of the latch-and-swap rule (pure).
+
+    Args:
+        ball_pos: (B, 2, 3) ball centres.
+        targets: (2, 3) T_a, T_b.
+        swapped: (B,) bool, current assignment (False: ball a -> T_a, ball b -> T_b).
+        latched: (B, 2) bool latches.
+
+    Returns:
+        (distances (B, 2) to the targets used this step, swap (B,) bool, new swapped, new latched)
+    """
+    current = torch.where(swapped[:, None, None], targets.flip(0)[None], targets[None])
+    dist = torch.linalg.vector_norm(ball_pos - current, dim=-1)
+    latched = latched | (dist < SUCCESS_RADIUS)
+    swap = latched.all(dim=1)
+    swapped = swapped ^ swap
+    latched = latched & ~swap[:, None]
+    return dist, swap, swapped, latched
+
+
+class Baoding:
+    """The Baoding task (robot-agnostic; targets and ball size come from the robot record)."""
+
+    name = "baoding"
+    display_name = "Baoding"
+    metric_names = ("swaps", "rotations")
+
+    def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
+        """Two 55 g balls of the robot's Baoding diameter."""
+        return baoding_balls(robot.baoding_ball_radius)
+
+    def init_state(self, robot: RobotSpec, num_envs: int, device: torch.device) -> BaodingState:
+        """Targets from the robot's calibration; latches clear."""
+        targets = torch.tensor(robot.baoding_targets, dtype=torch.float64, device=device)
+        return BaodingState(
+            targets=targets,
+            swapped=torch.zeros(num_envs, dtype=torch.bool, device=device),
+            latched=torch.zeros(num_envs, 2, dtype=torch.bool, device=device),
+            swaps=torch.zeros(num_envs, dtype=torch.int64, device=device),
+        )
+
+    def reset(self, state: BaodingState, env_ids: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        """Clear latches and assignment (ball a -> T_a, ball b -> T_b); place the balls.
+
+        Ball a starts on T_b and ball b on T_a (plus one shared U(±5 mm)³ offset): started on their
+        own targets, both would latch at once and the first swap would be free.
+        """
+        state.swapped[env_ids] = False
+        state.latched[env_ids] = False
+        state.swaps[env_ids] = 0
+        offset = uniform(generator, (len(env_ids), 1, 3), RESET_NOISE, state.targets.device)
+        return state.targets.flip(0)[None] + offset
+
+    def step(self, state: BaodingState, inputs: TaskInputs) -> StepResult:
+        """Latch, swap (+10), dense shaping; end when the balls part or drop."""
+        pos = inputs.ball_pos
+        dist, swap, state.swapped, state.latched = baoding_rule(pos, state.targets, state.swapped, state.latched)
+        state.swaps += swap.long()
+        dense = DENSE_SCALE * (1.0 - torch.tanh(dist / DENSE_LENGTH)).sum(dim=1)
+        separation = torch.linalg.vector_norm(pos[:, 0] - pos[:, 1], dim=-1)
+        dropped = (pos[:, :, 2] < -PALM_DROP_LIMIT).any(dim=1)
+        terminated = (separation >= MAX_SEPARATION) | dropped
+        return StepResult(
+            reward_terms={"swap": SWAP_REWARD * swap.to(pos.dtype), "distance": dense}, terminated=terminated
+        )
+
+    def metrics(self, state: BaodingState) -> dict[str, torch.Tensor]:
+        """Swaps and rotations (= swaps / 2) so far this episode."""
+        swaps = state.swaps.to(torch.float32)
+        return {"swaps": swaps, "rotations": swaps / 2.0}

@@ -1,0 +1,81 @@
+"""The task protocol: what every task provides, written once for every robot.
+
+A task sees the robot only as data (``RobotSpec``) and the simulation only as batched torch
+tensors (``TaskInputs``); it never names a robot and never touches a backend.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import torch
+
+from roto.robots.spec import RobotSpec
+from roto.sim.scene import BallSpec
+
+PALM_DROP_LIMIT = 0.2
+"""A ball more than this far below the palm centre (m) ends the episode (SPEC §5, §6)."""
+
+
+@dataclass(frozen=True)
+class TaskInputs:
+    """Per-step batched quantities a task reads (task frame: palm centre at the origin, z up).
+
+    Attributes:
+        ball_pos: (B, n_ball, 3) ball centres, m.
+        ball_vel: (B, n_ball, 3) ball linear velocities, m/s.
+        ball_contact: (B, n_ball) bool, the ball touched the hand during the control step.
+    """
+
+    ball_pos: torch.Tensor
+    ball_vel: torch.Tensor
+    ball_contact: torch.Tensor
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """What a task returns each step.
+
+    Attributes:
+        reward_terms: name -> (B,) reward term, already scaled; the reward is their sum.
+        terminated: (B,) bool, failure condition reached.
+    """
+
+    reward_terms: dict[str, torch.Tensor]
+    terminated: torch.Tensor
+
+
+class Task(Protocol):
+    """A robot-agnostic task."""
+
+    name: str
+    display_name: str
+    metric_names: tuple[str, ...]
+
+    def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
+        """The free objects this task puts in the scene for ``robot``."""
+        ...
+
+    def init_state(self, robot: RobotSpec, num_envs: int, device: torch.device) -> object:
+        """Fresh per-env task state (counters, latches)."""
+        ...
+
+    def reset(self, state: object, env_ids: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        """Clear the task state of ``env_ids`` (n,); return their initial ball positions (n, n_ball, 3)."""
+        ...
+
+    def step(self, state: object, inputs: TaskInputs) -> StepResult:
+        """Advance counters by one control step; return reward terms and terminations."""
+        ...
+
+    def metrics(self, state: object) -> dict[str, torch.Tensor]:
+        """Episode metrics so far, name -> (B,) float."""
+        ...
+
+
+def uniform(
+    generator: torch.Generator, shape: tuple[int, ...], half_width: float, device: torch.device
+) -> torch.Tensor:
+    """U(-half_width, half_width) samples of ``shape`` drawn from ``generator``."""
+    return (torch.rand(shape, generator=generator, device=device, dtype=torch.float64) * 2.0 - 1.0) * half_width

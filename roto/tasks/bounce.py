@@ -1,0 +1,102 @@
+"""Bounce: bounce a 70 mm ball on the palm as often as possible in 10 s (SPEC §5)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+
+from roto.robots.spec import RobotSpec
+from roto.sim.scene import BallSpec
+from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, uniform
+
+BALL = BallSpec(name="ball", radius=0.035, mass=0.030, friction=1.0)
+SPAWN_HEIGHT = 0.10
+"""Ball centre height above the palm centre at reset (m)."""
+SPAWN_NOISE = 0.01
+"""Half-width of the uniform spawn offset per axis (m)."""
+MIN_FLIGHT_STEPS = 5
+"""A new contact counts only after this many consecutive control steps without contact."""
+BOUNCE_REWARD = 10.0
+HORIZONTAL_LIMIT = 0.2
+"""A ball further than this from the palm centre horizontally ends the episode (m)."""
+
+
+@dataclass
+class BounceState:
+    """Per-env counters, each (B,)."""
+
+    prev_contact: torch.Tensor  # bool: ball touched the hand in the previous step
+    waiting: torch.Tensor  # bool: contact was lost since the last counted bounce
+    steps_without_contact: torch.Tensor  # int64: consecutive steps without contact before now
+    bounces: torch.Tensor  # int64: bounces this episode
+
+
+def bounce_counter(
+    contact: torch.Tensor,
+    prev_contact: torch.Tensor,
+    waiting: torch.Tensor,
+    steps_without_contact: torch.Tensor,
+    min_flight_steps: int = MIN_FLIGHT_STEPS,
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """One step of the bounce rule (pure; all inputs and outputs (B,)).
+
+    A contact that follows ``min_flight_steps`` or more steps without contact is a valid new
+    contact; it is a bounce if contact was lost since the last bounce. The first touchdown after a
+    spawn is therefore not a bounce.
+
+    Returns:
+        (bounce bool, new waiting bool, new steps_without_contact int64)
+    """
+    new_contact = contact & ~prev_contact
+    lost_contact = prev_contact & ~contact
+    valid = new_contact & (steps_without_contact >= min_flight_steps)
+    bounce = waiting & valid
+    waiting = (waiting | lost_contact) & ~bounce
+    steps_without_contact = torch.where(contact, torch.zeros_like(steps_without_contact), steps_without_contact + 1)
+    return bounce, waiting, steps_without_contact
+
+
+class Bounce:
+    """The Bounce task (robot-agnostic)."""
+
+    name = "bounce"
+    display_name = "Bounce"
+    metric_names = ("bounces",)
+
+    def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
+        """One 70 mm, 30 g ball for every hand."""
+        return (BALL,)
+
+    def init_state(self, robot: RobotSpec, num_envs: int, device: torch.device) -> BounceState:
+        """All counters at zero."""
+        zeros_b = torch.zeros(num_envs, dtype=torch.bool, device=device)
+        zeros_i = torch.zeros(num_envs, dtype=torch.int64, device=device)
+        return BounceState(zeros_b, zeros_b.clone(), zeros_i, zeros_i.clone())
+
+    def reset(self, state: BounceState, env_ids: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        """Clear counters; ball ~10 cm above the palm centre plus U(±1 cm) per axis."""
+        state.prev_contact[env_ids] = False
+        state.waiting[env_ids] = False
+        state.steps_without_contact[env_ids] = 0
+        state.bounces[env_ids] = 0
+        device = state.bounces.device
+        pos = uniform(generator, (len(env_ids), 1, 3), SPAWN_NOISE, device)
+        pos[..., 2] += SPAWN_HEIGHT
+        return pos
+
+    def step(self, state: BounceState, inputs: TaskInputs) -> StepResult:
+        """Count bounces (hand-ball contact only), reward 10 per bounce, end on a dropped ball."""
+        contact = inputs.ball_contact[:, 0]
+        bounce, state.waiting, state.steps_without_contact = bounce_counter(
+            contact, state.prev_contact, state.waiting, state.steps_without_contact
+        )
+        state.prev_contact = contact
+        state.bounces += bounce.long()
+        pos = inputs.ball_pos[:, 0]
+        terminated = (pos[:, 2] < -PALM_DROP_LIMIT) | (torch.linalg.vector_norm(pos[:, :2], dim=-1) > HORIZONTAL_LIMIT)
+        return StepResult(reward_terms={"bounce": BOUNCE_REWARD * bounce.to(pos.dtype)}, terminated=terminated)
+
+    def metrics(self, state: BounceState) -> dict[str, torch.Tensor]:
+        """Bounces so far this episode."""
+        return {"bounces": state.bounces.to(torch.float32)}

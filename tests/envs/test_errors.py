@@ -1,0 +1,78 @@
+import pytest
+import torch
+
+import roto
+from tests.conftest import make_env
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "pattern"),
+    [
+        ({"task": "juggle"}, r"unknown task 'juggle'.*baoding.*bounce"),
+        ({"task": "bounce", "robot": "leap"}, r"unknown robot 'leap'.*shadow"),
+        ({"task": "bounce", "obs_mode": "vision"}, r"unknown obs_mode 'vision'.*blind.*state.*proprio"),
+        ({"task": "bounce", "num_envs": 0}, r"num_envs must be an integer >= 1, got 0"),
+        ({"task": "bounce", "backend": "jax"}, r"unknown backend 'jax'.*cpu"),
+        ({"task": "bounce", "device": "cuda"}, r"device 'cuda' is not available"),
+    ],
+)
+def test_bad_construction_arguments(kwargs, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        roto.make(**kwargs)
+
+
+def test_names_are_case_insensitive():
+    env = roto.make("BOUNCE", robot="Shadow")
+    assert env.task.name == "bounce"
+    env.close()
+
+
+@pytest.fixture
+def env():
+    env = make_env("bounce", num_envs=2)
+    env.reset()
+    yield env
+    env.close()
+
+
+def test_wrong_action_shape(env):
+    with pytest.raises(ValueError, match=r"action shape \(2, 19\) is wrong; expected .* \(2, 20\)"):
+        env.step(torch.zeros(2, 19))
+
+
+def test_wrong_action_dtype(env):
+    with pytest.raises(TypeError, match=r"action dtype torch.int64 is not floating point"):
+        env.step(torch.zeros(2, 20, dtype=torch.int64))
+
+
+def test_action_not_a_tensor(env):
+    with pytest.raises(TypeError, match=r"action must be a torch.Tensor"):
+        env.step([[0.0] * 20] * 2)
+
+
+def test_wrong_action_device(env):
+    with pytest.raises(ValueError, match=r"action is on device meta; this env runs on cpu"):
+        env.step(torch.zeros(2, 20, device="meta"))
+
+
+def test_non_finite_action_names_the_env_and_loses_nothing(env):
+    before = env.backend.state.copy()
+    action = torch.zeros(2, 20)
+    action[1, 3] = float("nan")
+    with pytest.raises(ValueError, match=r"non-finite values .* in envs \[1\]"):
+        env.step(action)
+    assert (env.backend.state == before).all()
+    env.step(torch.zeros(2, 20))  # still usable
+
+
+def test_step_before_reset():
+    env = make_env("bounce")
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(torch.zeros(2, 20))
+
+
+def test_step_never_modifies_the_callers_action(env):
+    action = torch.full((2, 20), 0.5)
+    for _ in range(40):  # long enough for terminations and resets
+        env.step(action)
+    assert torch.all(action == 0.5)

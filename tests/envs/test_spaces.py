@@ -1,0 +1,54 @@
+import numpy as np
+import pytest
+import torch
+
+from tests.conftest import make_env
+
+SIZES = {"blind": {"tactile": 17, "proprio": 80}, "state": {"tactile": 17, "proprio": 80}, "proprio": {"proprio": 80}}
+
+
+@pytest.mark.parametrize("task", ["bounce", "baoding"])
+@pytest.mark.parametrize("obs_mode", ["blind", "state", "proprio"])
+def test_observation_sizes_dtypes_and_spaces(task, obs_mode):
+    env = make_env(task, obs_mode=obs_mode, num_envs=3)
+    expected = dict(SIZES[obs_mode])
+    if obs_mode == "state":
+        expected["privileged"] = 6 if task == "bounce" else 12
+    assert env.frame_sizes == expected
+    obs, _ = env.reset()
+    obs2, reward, terminated, truncated, _ = env.step(torch.zeros(3, 20))
+    for o in (obs, obs2):
+        assert list(o) == list(expected)
+        for name, value in o.items():
+            assert value.dtype == torch.float32 and value.shape == (3, 4 * expected[name])
+            assert env.observation_space[name].contains(value[0].numpy())
+    assert reward.shape == (3,) and terminated.dtype == torch.bool and truncated.dtype == torch.bool
+    assert env.action_space.shape == (20,)
+    env.close()
+
+
+def test_shadow_blind_frame_is_97_and_stack_388():
+    env = make_env("bounce", obs_mode="blind")
+    assert sum(env.frame_sizes.values()) == 97
+    obs, _ = env.reset()
+    assert sum(v.shape[1] for v in obs.values()) == 388
+
+
+def test_stack_is_filled_with_copies_of_the_first_frame_at_reset():
+    env = make_env("bounce", num_envs=2)
+    obs, _ = env.reset()
+    frames = obs["proprio"].reshape(2, 4, -1)
+    for k in range(1, 4):
+        torch.testing.assert_close(frames[:, k], frames[:, 0])
+    obs, *_ = env.step(torch.zeros(2, 20))
+    frames2 = obs["proprio"].reshape(2, 4, -1)
+    torch.testing.assert_close(frames2[:, :3], frames[:, 1:])  # oldest dropped, newest appended
+    assert not torch.equal(frames2[:, 3], frames[:, 3])
+
+
+def test_proprio_normalised_positions_are_within_bounds():
+    env = make_env("baoding", num_envs=4)
+    obs, _ = env.reset()
+    pos = obs["proprio"].reshape(4, 4, -1)[:, -1, :20]
+    assert torch.all(pos >= -1.0001) and torch.all(pos <= 1.0001)
+    assert np.isfinite(obs["proprio"].numpy()).all()

@@ -1,0 +1,74 @@
+import torch
+
+from roto.robots import get_robot
+from roto.tasks.baoding import Baoding, baoding_rule
+from roto.tasks.base import TaskInputs
+
+SHADOW = get_robot("shadow")
+TARGETS = torch.tensor(SHADOW.baoding_targets, dtype=torch.float64)
+
+
+def _inputs(pos_a, pos_b) -> TaskInputs:
+    pos = torch.tensor([[pos_a, pos_b]], dtype=torch.float64)
+    return TaskInputs(ball_pos=pos, ball_vel=torch.zeros_like(pos), ball_contact=torch.ones(1, 2, dtype=torch.bool))
+
+
+def test_latches_then_swap_with_reward():
+    task = Baoding()
+    state = task.init_state(SHADOW, 1, torch.device("cpu"))
+    t_a, t_b = TARGETS.tolist()
+    far = [0.0, 0.1, 0.05]
+    r1 = task.step(state, _inputs(t_a, far))  # ball a latches, b far
+    assert state.latched.tolist() == [[True, False]] and r1.reward_terms["swap"][0] == 0
+    r2 = task.step(state, _inputs(far, t_b))  # a left again (latch holds), b arrives -> swap
+    assert r2.reward_terms["swap"][0] == 10.0
+    assert state.swapped.tolist() == [True] and state.latched.tolist() == [[False, False]]
+    assert task.metrics(state)["swaps"].tolist() == [1.0] and task.metrics(state)["rotations"].tolist() == [0.5]
+    # targets are now swapped: a must reach T_b and b T_a
+    r3 = task.step(state, _inputs(t_a, t_b))
+    assert r3.reward_terms["swap"][0] == 0 and state.latched.tolist() == [[False, False]]
+    r4 = task.step(state, _inputs(t_b, t_a))
+    assert r4.reward_terms["swap"][0] == 10.0 and task.metrics(state)["rotations"].tolist() == [1.0]
+
+
+def test_dense_reward_matches_formula():
+    task = Baoding()
+    state = task.init_state(SHADOW, 1, torch.device("cpu"))
+    t_a, t_b = TARGETS
+    pos_a = t_a + torch.tensor([0.03, 0.0, 0.0], dtype=torch.float64)
+    pos_b = t_b + torch.tensor([0.0, 0.04, 0.0], dtype=torch.float64)
+    result = task.step(state, _inputs(pos_a.tolist(), pos_b.tolist()))
+    expected = 0.1 * ((1 - torch.tanh(torch.tensor(0.3))) + (1 - torch.tanh(torch.tensor(0.4))))
+    torch.testing.assert_close(result.reward_terms["distance"][0].float(), expected, rtol=1e-5, atol=1e-6)
+
+
+def test_rule_distance_uses_current_assignment():
+    pos = torch.stack([TARGETS[1], TARGETS[0]])[None]
+    dist, swap, swapped, _latched = baoding_rule(
+        pos, TARGETS, torch.tensor([True]), torch.zeros(1, 2, dtype=torch.bool)
+    )
+    assert torch.allclose(dist, torch.zeros(1, 2, dtype=torch.float64)) and swap[0] and not swapped[0]
+
+
+def test_terminations():
+    task = Baoding()
+    state = task.init_state(SHADOW, 1, torch.device("cpu"))
+    assert not task.step(state, _inputs([0, 0, 0.01], [0.1, 0, 0.01])).terminated[0]
+    assert task.step(state, _inputs([0, 0, 0.01], [0.16, 0, 0.01])).terminated[0]
+    assert task.step(state, _inputs([0, 0, -0.21], [0.03, 0, 0.01])).terminated[0]
+
+
+def test_reset_clears_state_and_places_balls_on_the_other_target():
+    task = Baoding()
+    state = task.init_state(SHADOW, 2, torch.device("cpu"))
+    state.swapped[:] = True
+    state.latched[:] = True
+    state.swaps[:] = 3
+    pos = task.reset(state, torch.tensor([1]), torch.Generator().manual_seed(0))
+    assert state.swapped.tolist() == [True, False] and state.swaps.tolist() == [3, 0]
+    assert state.latched.tolist() == [[True, True], [False, False]]
+    offset = pos[0] - TARGETS.flip(0)
+    assert torch.all(offset.abs() <= 0.005) and torch.allclose(offset[0], offset[1])
+    # no swap is free: neither ball starts within the success radius of its own target
+    dist, swap, *_ = baoding_rule(pos, TARGETS, torch.tensor([False]), torch.zeros(1, 2, dtype=torch.bool))
+    assert not swap[0] and torch.all(dist > 0.01)

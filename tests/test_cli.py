@@ -1,0 +1,30 @@
+import json
+
+from roto.cli import main
+
+
+def test_list_prints_every_pair_with_sizes(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    assert "roto/Bounce-Shadow-v0" in out and "roto/Baoding-Shadow-v0" in out
+    assert "97" in out and "388" in out
+
+
+def test_bench_json_has_the_contract_fields(capsys):
+    assert main(["bench", "--task", "baoding", "--num_envs", "4", "--steps", "8", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    for key in ("env_steps_per_s", "raw_physics_steps_per_s", "substeps", "threads", "efficiency"):
+        assert key in result
+    expected = result["env_steps_per_s"] * result["substeps"] / (result["threads"] * result["raw_physics_steps_per_s"])
+    assert abs(result["efficiency"] - expected) < 1e-2
+
+
+def test_bad_task_is_a_clear_error(capsys):
+    assert main(["bench", "--task", "juggle", "--num_envs", "2", "--steps", "1"]) == 2
+    assert "unknown task 'juggle'" in capsys.readouterr().err
+
+
+def test_demo_runs_the_scripted_policy(capsys):
+    assert main(["demo", "--num_envs", "2", "--episodes", "1"]) == 0
+    stats = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert stats["episodes"] == 2 and stats["mean_bounces"] >= 0
