@@ -111,11 +111,7 @@ def scene_layout(model: mujoco.MjModel, robot: RobotSpec, balls: tuple[BallSpec,
     ball_joints = np.array([model.joint(f"{b.name}_free").id for b in balls], dtype=np.int64)
     ball_ids = {model.joint(j).id for j in (f"{b.name}_free" for b in balls)}
     hand_joints = np.array([j for j in range(model.njnt) if j not in ball_ids], dtype=np.int64)
-    for name in robot.actuated_joints:
-        actuator_joint = [model.actuator_trnid[i, 0] for i in range(model.nu)]
-        if model.joint(name).id not in actuator_joint:
-            raise ValueError(f"robot {robot.name!r}: joint {name!r} has no actuator")
-    act_order = [int(np.flatnonzero(model.actuator_trnid[:, 0] == j)[0]) for j in act]
+    act_order = [int(i) for j in act for i in np.flatnonzero(model.actuator_trnid[:, 0] == j)]
     if act_order != list(range(model.nu)):
         raise ValueError(f"robot {robot.name!r}: actuator order must follow actuated_joints, got {act_order}")
 

@@ -4,17 +4,17 @@ import torch
 from tests.conftest import make_env
 
 
-def test_time_out_truncates_at_600_and_resets_in_the_same_step():
-    env = make_env("baoding", num_envs=2, episode_steps=600)
+def test_time_out_truncates_at_episode_steps_and_resets_in_the_same_step():
+    env = make_env("baoding", num_envs=2, episode_steps=30)
     env.reset()
-    hold = torch.zeros(2, 20)
-    for step in range(1, 601):
-        _obs, _, terminated, truncated, info = env.step(hold)
-        if terminated.any():  # a world may fail earlier; then its counter restarts
-            continue
-        if step < 600:
-            assert not truncated.any()
-    assert truncated.any() or "episode" in info
+    idx = env._idx
+    hold = (2 * (idx.default_qpos[0, idx.act_qpos] - idx.ctrl_lo) / (idx.ctrl_hi - idx.ctrl_lo) - 1).float()
+    for step in range(1, 31):
+        _, _, terminated, truncated, info = env.step(hold.expand(2, -1))
+        assert not terminated.any()
+        assert truncated.all() == (step == 30) and truncated.any() == (step == 30)
+    assert info["episode"]["time_out"].all() and info["episode"]["l"].tolist() == [30, 30]
+    assert env._episode.length.tolist() == [0, 0]  # already reset within the step
     env.close()
 
 
