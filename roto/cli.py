@@ -1,4 +1,4 @@
-"""``roto`` command line: ``roto list``, ``roto bench``, ``roto demo``."""
+"""``roto`` command line: ``roto train``, ``eval``, ``play``, ``list``, ``bench``, ``demo``."""
 
 from __future__ import annotations
 
@@ -59,10 +59,111 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_train(args: argparse.Namespace) -> int:
+    import dataclasses
+    import pathlib
+    import time
+
+    import torch
+
+    from roto.rl.config import load_agent_config
+    from roto.rl.runner import Trainer, TrainSettings
+
+    torch.set_num_threads(args.torch_threads)
+    if args.resume:
+        trainer = Trainer.resume(args.resume, total_steps=args.steps)
+    else:
+        settings = TrainSettings(
+            task=args.task,
+            robot=args.robot,
+            obs_mode=args.obs,
+            num_envs=args.num_envs,
+            total_steps=args.steps if args.steps is not None else 1_000_000,
+            seed=args.seed,
+            backend=args.backend,
+            threads=args.threads,
+        )
+        settings.env_config()  # validate task / robot / obs mode / backend before anything is written
+        agent = load_agent_config(args.task, args.agent_cfg, args.overrides)
+        run_dir = args.run_dir or pathlib.Path("runs") / (
+            f"{args.task}_{args.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{args.seed}"
+        )
+        trainer = Trainer(settings, agent, run_dir)
+    print(f"run directory: {trainer.run_dir}", file=sys.stderr)
+    last = trainer.train(progress=not args.no_progress)
+    summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
+    summary.update({k.removeprefix("eval/"): v for k, v in last.items()})
+    summary["settings"] = dataclasses.asdict(trainer.settings)
+    print(json.dumps(summary))
+    return 0
+
+
+def _cmd_eval(args: argparse.Namespace) -> int:
+    import pathlib
+
+    from roto.eval.evaluate import evaluate
+    from roto.rl.runner import load_policy
+
+    model, settings, _ = load_policy(args.checkpoint)
+    result = evaluate(model, settings, episodes=args.episodes, seed=args.seed)
+    result = {"checkpoint": str(args.checkpoint), "task": settings.task, "robot": settings.robot, **result}
+    out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
+    out.write_text(json.dumps(result, indent=1))
+    print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))
+    print(f"wrote {out}", file=sys.stderr)
+    return 0
+
+
+def _cmd_play(args: argparse.Namespace) -> int:
+    from roto.eval.video import record_video
+    from roto.rl.runner import load_policy
+
+    model, settings, _ = load_policy(args.checkpoint)
+    result = record_video(model, settings, args.video, steps=args.video_length, seed=args.seed)
+    print(json.dumps({"video": str(args.video), **result}))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``roto`` argument parser."""
     parser = argparse.ArgumentParser(prog="roto", description="roto: the Robot Tactile Olympiad on MuJoCo")
     sub = parser.add_subparsers(dest="command", required=True)
+
+    p_train = sub.add_parser("train", help="train roto's PPO agent (progress bar, logs, checkpoints)")
+    _add_env_args(p_train, num_envs=64)
+    p_train.add_argument(
+        "--obs", "--obs_mode", "--obs-mode", dest="obs", default="blind", help="blind, state or proprio"
+    )
+    p_train.add_argument(
+        "--steps", type=int, default=None, help="env-step budget (default 1e6; with --resume: unchanged)"
+    )
+    p_train.add_argument(
+        "--agent_cfg", "--agent-cfg", dest="agent_cfg", default=None, help="agent YAML (default: the task's)"
+    )
+    p_train.add_argument("--backend", default="cpu", help="simulation backend (default: cpu)")
+    p_train.add_argument(
+        "--run_dir", "--run-dir", dest="run_dir", default=None, help="default: runs/<task>_<robot>_<obs>/<time>"
+    )
+    p_train.add_argument("--resume", default=None, metavar="RUN_DIR", help="continue a run from its latest checkpoint")
+    p_train.add_argument("--torch_threads", "--torch-threads", dest="torch_threads", type=int, default=1)
+    p_train.add_argument("--no_progress", "--no-progress", dest="no_progress", action="store_true")
+    p_train.add_argument("overrides", nargs="*", metavar="section.key=value", help="agent config overrides")
+    p_train.set_defaults(func=_cmd_train)
+
+    p_eval = sub.add_parser("eval", help="evaluate a checkpoint over full episodes (deterministic policy)")
+    p_eval.add_argument("--checkpoint", required=True)
+    p_eval.add_argument("--episodes", type=int, default=100)
+    p_eval.add_argument("--seed", type=int, default=1_000_000)
+    p_eval.add_argument("--out", default=None, help="JSON path (default: next to the checkpoint)")
+    p_eval.set_defaults(func=_cmd_eval)
+
+    p_play = sub.add_parser("play", help="render a checkpoint's policy offscreen into an mp4")
+    p_play.add_argument("--checkpoint", required=True)
+    p_play.add_argument("--video", default="videos/play.mp4", help="mp4 path (default: videos/play.mp4)")
+    p_play.add_argument("--video_length", "--video-length", dest="video_length", type=int, default=600)
+    p_play.add_argument("--seed", type=int, default=0)
+    p_play.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; always headless")
+    p_play.set_defaults(func=_cmd_play)
 
     p_list = sub.add_parser("list", help="every (task, robot) pair with its observation and action sizes")
     p_list.set_defaults(func=_cmd_list)
@@ -86,7 +187,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
-    except (ValueError, TypeError) as error:
+    except (ValueError, TypeError, FileNotFoundError, KeyError) as error:
         print(f"roto {args.command}: error: {error}", file=sys.stderr)
         return 2
 

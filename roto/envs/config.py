@@ -48,6 +48,11 @@ class EnvConfig:
 
     def __post_init__(self) -> None:
         """Reject impossible values with a message naming the value and the valid choices."""
+        from roto.robots import get_robot
+        from roto.tasks import get_task
+
+        get_task(self.task)
+        get_robot(self.robot)
         if self.obs_mode not in OBS_MODES:
             raise ValueError(f"unknown obs_mode {self.obs_mode!r}; valid obs modes: {list(OBS_MODES)}")
         if self.backend not in BACKENDS:

@@ -7,6 +7,7 @@ One ``step`` runs, in this order (DESIGN §1):
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -139,6 +140,47 @@ class RotoEnv:
     def close(self) -> None:
         """Release the backend's threads."""
         self.backend.close()
+
+    def state_dict(self) -> dict[str, Any]:
+        """Everything that decides the env's future: physics, task counters, frame stack, RNG.
+
+        ``load_state_dict`` of it on an env built from the same config continues bit-identically
+        (what exact training resume relies on).
+        """
+        return {
+            "physics": torch.from_numpy(self.backend.state.copy()),
+            "task": {f.name: getattr(self.task_state, f.name).clone() for f in dataclasses.fields(self.task_state)},
+            "frames": {name: value.clone() for name, value in self._stack._frames.items()},
+            "episode_length": self._episode.length.clone(),
+            "episode_return": self._episode.ret.clone(),
+            "term_sums": {name: value.clone() for name, value in self._term_sums.items()},
+            "target": self._target.clone(),
+            "last_action": self._last_action.clone(),
+            "generator": self._generator.get_state(),
+            "nonfinite_resets": self.nonfinite_resets,
+            "needs_reset": self._needs_reset,
+        }
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore what ``state_dict`` returned (same config: task, robot, num_envs)."""
+        physics = state["physics"].numpy()
+        if physics.shape != self.backend.state.shape:
+            raise ValueError(
+                f"env state holds {physics.shape[0]} worlds of size {physics.shape[1]}, "
+                f"this env has {self.backend.state.shape}"
+            )
+        self.backend.state[:] = physics
+        for name, value in state["task"].items():
+            setattr(self.task_state, name, value.clone().to(self.device))
+        self._stack._frames = {name: value.clone().to(self.device) for name, value in state["frames"].items()}
+        self._episode.length = state["episode_length"].clone().to(self.device)
+        self._episode.ret = state["episode_return"].clone().to(self.device)
+        self._term_sums = {name: value.clone().to(self.device) for name, value in state["term_sums"].items()}
+        self._target = state["target"].clone().to(self.device)
+        self._last_action = state["last_action"].clone().to(self.device)
+        self._generator.set_state(state["generator"])
+        self.nonfinite_resets = int(state["nonfinite_resets"])
+        self._needs_reset = bool(state["needs_reset"])
 
     @property
     def unwrapped(self) -> RotoEnv:

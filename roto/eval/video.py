@@ -1,0 +1,100 @@
+"""Render episodes of a policy offscreen into an mp4 (no display needed).
+
+Tactile links are drawn in a contact colour while their touch bit is on.
+"""
+
+from __future__ import annotations
+
+import pathlib
+
+import mujoco
+import numpy as np
+import torch
+
+from roto.envs.roto_env import RotoEnv
+from roto.rl.networks import ActorCritic
+from roto.rl.runner import TrainSettings, flatten_obs
+
+TOUCH_RGBA = np.array([0.1, 0.9, 0.2, 1.0], dtype=np.float32)
+FPS = 60
+"""One frame per control step (60 Hz), so the video plays in real time."""
+
+
+def _camera() -> mujoco.MjvCamera:
+    camera = mujoco.MjvCamera()
+    camera.lookat[:] = (0.03, 0.0, 0.02)
+    camera.distance = 0.42
+    camera.azimuth = 150.0
+    camera.elevation = -30.0
+    return camera
+
+
+class TactileFrameRenderer:
+    """Renders world 0 of an env, colouring the geoms of tactile links whose bit is on."""
+
+    def __init__(self, env: RotoEnv, width: int = 640, height: int = 480) -> None:
+        self.env = env
+        self.model = env.model
+        self.data = mujoco.MjData(self.model)
+        self.renderer = mujoco.Renderer(self.model, height=height, width=width)
+        self.camera = _camera()
+        self._base_rgba = self.model.geom_rgba.copy()
+        body_ids = [self.model.body(link).id for link in env.robot.tactile_links]
+        self._link_geoms = [np.flatnonzero(self.model.geom_bodyid == b) for b in body_ids]
+
+    def render(self) -> np.ndarray:
+        """(height, width, 3) uint8 of world 0, touching links coloured (same threshold as the env)."""
+        mujoco.mj_setState(self.model, self.data, self.env.backend.state[0], mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        mujoco.mj_forward(self.model, self.data)
+        force = self.data.sensordata[self.env.layout.tactile_sensor + 1]
+        self.model.geom_rgba[:] = self._base_rgba
+        for f, geoms in zip(force.tolist(), self._link_geoms, strict=True):
+            if f > self.env.config.tactile_threshold:
+                self.model.geom_rgba[geoms] = TOUCH_RGBA
+        self.renderer.update_scene(self.data, camera=self.camera)
+        return self.renderer.render().copy()
+
+    def close(self) -> None:
+        """Free the GL context and restore the colours."""
+        self.model.geom_rgba[:] = self._base_rgba
+        self.renderer.close()
+
+
+@torch.no_grad()
+def record_video(
+    model: ActorCritic,
+    settings: TrainSettings,
+    path: str | pathlib.Path,
+    steps: int = 600,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+) -> dict[str, float]:
+    """Write ``steps`` control steps of world 0 (episodes restart when they end) to ``path`` (mp4).
+
+    Returns the number of frames and the return, and task metrics of the episodes that finished.
+    """
+    import imageio.v2 as imageio
+
+    if steps < 1:
+        raise ValueError(f"video length must be >= 1 step, got {steps}")
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    env = RotoEnv(settings.env_config(num_envs=1, seed=seed))
+    renderer = TactileFrameRenderer(env, width, height)
+    obs_dict, _ = env.reset(seed=seed)
+    frames = 0
+    finished: list[dict[str, float]] = []
+    writer = imageio.get_writer(str(path), format="FFMPEG", fps=FPS, codec="libx264", quality=7, macro_block_size=8)
+    try:
+        for _ in range(steps):
+            obs_dict, _, _, _, info = env.step(model.act_deterministic(flatten_obs(obs_dict)))
+            writer.append_data(renderer.render())
+            frames += 1
+            if "episode" in info and bool(info["_episode"][0]):
+                finished.append({k: float(v[0]) for k, v in info["episode"].items()})
+    finally:
+        writer.close()
+        renderer.close()
+        env.close()
+    return {"frames": frames, "episodes": finished}

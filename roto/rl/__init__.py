@@ -1,0 +1,1 @@
+"""roto's PPO agent: networks, normalisers, GAE, losses, storage, the update and the training loop."""

@@ -1,0 +1,191 @@
+"""Agent configuration: frozen dataclasses read from plain YAML with strict keys.
+
+A config file mirrors ``AgentConfig``: sections ``network``, ``ppo`` and ``run``. An unknown key is
+an error naming its dotted path; a missing key keeps its default. ``key=value`` overrides (e.g.
+``ppo.lr=1e-4``) are applied on top, with the value parsed as YAML.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.resources
+import pathlib
+import typing
+from dataclasses import dataclass, field
+from typing import Any
+
+import yaml
+
+
+@dataclass(frozen=True, kw_only=True)
+class NetworkConfig:
+    """Shared encoder and heads (SPEC §7)."""
+
+    encoder: tuple[int, ...] = (512, 256)
+    policy_head: tuple[int, ...] = (128, 64)
+    value_head: tuple[int, ...] = (128, 64)
+    init_log_std: float = 0.0
+    obs_normalization: bool = True
+
+
+@dataclass(frozen=True, kw_only=True)
+class PPOConfig:
+    """PPO hyperparameters (SPEC §7; defaults are roto's Bounce values)."""
+
+    rollouts: int = 16
+    epochs: int = 17
+    minibatches: int = 8
+    gamma: float = 0.99
+    lam: float = 0.951
+    lr: float = 2.59e-4
+    ratio_clip: float = 0.285
+    value_clip: float = 0.105
+    value_coef: float = 0.999
+    entropy_coef: float = 0.0161
+    max_grad_norm: float = 1.0
+    kl_adaptive: bool = False
+    kl_target: float = 0.008
+    kl_factor: float = 1.5
+    lr_min: float = 1e-6
+    lr_max: float = 1e-2
+    value_normalization: bool = True
+    bootstrap_timeouts: bool = False
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunConfig:
+    """Evaluation, logging and checkpoint cadence of a training run."""
+
+    num_eval_envs: int = 8
+    checkpoint_every: int = 50
+    """Write ``latest.pt`` (and keep ``agent_<update>.pt``) every this many updates."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class AgentConfig:
+    """Everything that defines the learner."""
+
+    network: NetworkConfig = field(default_factory=NetworkConfig)
+    ppo: PPOConfig = field(default_factory=PPOConfig)
+    run: RunConfig = field(default_factory=RunConfig)
+
+    def validate(self) -> AgentConfig:
+        """Raise ValueError on values no run can use; return self."""
+        p = self.ppo
+        positive = {"ppo.rollouts": p.rollouts, "ppo.epochs": p.epochs, "ppo.minibatches": p.minibatches}
+        positive["run.num_eval_envs"] = self.run.num_eval_envs
+        positive["run.checkpoint_every"] = self.run.checkpoint_every
+        for name, value in positive.items():
+            if value < 1:
+                raise ValueError(f"{name} must be >= 1, got {value}")
+        if not (0.0 < p.gamma <= 1.0 and 0.0 <= p.lam <= 1.0):
+            raise ValueError(f"ppo.gamma must be in (0, 1] and ppo.lam in [0, 1], got {p.gamma}, {p.lam}")
+        if p.lr <= 0.0:
+            raise ValueError(f"ppo.lr must be > 0, got {p.lr}")
+        return self
+
+
+def _coerce(value: Any, annotation: Any, path: str) -> Any:
+    origin = typing.get_origin(annotation)
+    if dataclasses.is_dataclass(annotation):
+        return from_dict(annotation, value, path)
+    if origin is tuple:
+        if not isinstance(value, list | tuple) or not all(
+            isinstance(v, int) and not isinstance(v, bool) for v in value
+        ):
+            raise ValueError(f"{path} must be a list of integers, got {value!r}")
+        return tuple(value)
+    if annotation is bool:
+        if not isinstance(value, bool):
+            raise ValueError(f"{path} must be true or false, got {value!r}")
+        return value
+    if annotation is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ValueError(f"{path} must be an integer, got {value!r}")
+        return value
+    if annotation is float:
+        if isinstance(value, str):  # YAML 1.1 reads 1e-3 (no dot) as a string
+            try:
+                value = float(value)
+            except ValueError:
+                pass
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ValueError(f"{path} must be a number, got {value!r}")
+        return float(value)
+    raise TypeError(f"{path}: unsupported annotation {annotation!r}")  # pragma: no cover
+
+
+def from_dict(cls: type, data: Any, path: str = "") -> Any:
+    """Build dataclass ``cls`` from a mapping; unknown keys raise ValueError with their dotted path."""
+    where = path or "the agent config"
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ValueError(f"{where} must be a mapping, got {data!r}")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name for f in dataclasses.fields(cls)}
+    for key in data:
+        if key not in fields:
+            dotted = f"{path}.{key}" if path else str(key)
+            raise ValueError(f"unknown config key {dotted!r}; valid keys here: {sorted(fields)}")
+    values = {k: _coerce(v, hints[k], f"{path}.{k}" if path else k) for k, v in data.items()}
+    return cls(**values)
+
+
+def to_dict(config: Any) -> dict[str, Any]:
+    """Plain nested dict (tuples as lists), ready for YAML."""
+
+    def plain(value: Any) -> Any:
+        if isinstance(value, tuple):
+            return list(value)
+        if isinstance(value, dict):
+            return {k: plain(v) for k, v in value.items()}
+        return value
+
+    return plain(dataclasses.asdict(config))
+
+
+def apply_overrides(data: dict[str, Any], overrides: list[str]) -> dict[str, Any]:
+    """Apply ``section.key=value`` overrides to a nested dict (a new dict is returned)."""
+    merged = yaml.safe_load(yaml.safe_dump(data)) or {}
+    for item in overrides:
+        key, sep, raw = item.partition("=")
+        if not sep or not key:
+            raise ValueError(f"override {item!r} must look like section.key=value (e.g. ppo.lr=1e-4)")
+        node = merged
+        *parents, leaf = key.split(".")
+        for part in parents:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise ValueError(f"override {item!r}: {part!r} is not a section")
+        node[leaf] = yaml.safe_load(raw)
+    return merged
+
+
+def default_config_path(task: str) -> pathlib.Path:
+    """The packaged default agent config of a task (``roto/configs/<task>.yaml``)."""
+    return pathlib.Path(str(importlib.resources.files("roto") / "configs" / f"{task}.yaml"))
+
+
+def load_agent_config(
+    task: str, path: str | pathlib.Path | None = None, overrides: list[str] | None = None
+) -> AgentConfig:
+    """The task's default config, or the YAML file at ``path``, with ``overrides`` applied; validated."""
+    source = pathlib.Path(path) if path is not None else default_config_path(task)
+    if not source.is_file():
+        raise FileNotFoundError(f"agent config {str(source)!r} does not exist")
+    data = yaml.safe_load(source.read_text()) or {}
+    data = apply_overrides(data, overrides or [])
+    return from_dict(AgentConfig, data).validate()
+
+
+__all__ = [
+    "AgentConfig",
+    "NetworkConfig",
+    "PPOConfig",
+    "RunConfig",
+    "apply_overrides",
+    "from_dict",
+    "load_agent_config",
+    "to_dict",
+]

@@ -1,0 +1,100 @@
+"""Smoke tests of ``roto train / eval / play`` (tiny budgets) and their error messages."""
+
+import json
+import struct
+
+import imageio.v2 as imageio
+import pytest
+
+from roto.cli import main
+
+TINY = [
+    "network.encoder=[16]",
+    "network.policy_head=[8]",
+    "network.value_head=[8]",
+    "ppo.rollouts=4",
+    "ppo.epochs=1",
+    "ppo.minibatches=1",
+    "run.num_eval_envs=2",
+    "run.checkpoint_every=1",
+]
+
+
+def read_event_tags(events_dir):
+    """Scalar tags in TensorBoard event files (TFRecord framing: length, crc, payload, crc)."""
+    from tensorboardX.proto import event_pb2
+
+    tags = set()
+    for path in events_dir.glob("events.out.tfevents.*"):
+        data = path.read_bytes()
+        offset = 0
+        while offset < len(data):
+            (length,) = struct.unpack("<Q", data[offset : offset + 8])
+            payload = data[offset + 12 : offset + 12 + length]
+            offset += 12 + length + 4
+            event = event_pb2.Event.FromString(payload)
+            tags.update(v.tag for v in event.summary.value)
+    return tags
+
+
+@pytest.fixture(scope="module")
+def trained_run(tmp_path_factory):
+    run_dir = tmp_path_factory.mktemp("cli") / "run"
+    args = ["train", "--num_envs", "4", "--steps", "48", "--run_dir", str(run_dir), "--no_progress", *TINY]
+    assert main(args) == 0
+    return run_dir
+
+
+def test_train_writes_config_checkpoints_csv_and_events(trained_run, capsys):
+    assert (trained_run / "config.yaml").is_file()
+    ckpts = trained_run / "checkpoints"
+    assert (ckpts / "latest.pt").is_file() and (ckpts / "agent_3.pt").is_file()
+    csv_text = (trained_run / "scalars.csv").read_text()
+    for tag in ("ppo/approx_kl", "ppo/clip_fraction", "ppo/explained_variance", "ppo/entropy", "ppo/action_std",
+                "ppo/lr", "perf/simulation_s", "perf/inference_s", "perf/update_s"):  # fmt: skip
+        assert f",{tag}," in csv_text
+    tags = read_event_tags(trained_run / "tensorboard")
+    assert {"ppo/approx_kl", "perf/steps_per_s"} <= tags
+
+
+def test_resume_extends_a_run(trained_run, capsys):
+    assert main(["train", "--resume", str(trained_run), "--steps", "64", "--no_progress"]) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["updates"] == 4 and summary["env_steps"] == 64
+
+
+def test_eval_prints_and_writes_json(trained_run, tmp_path, capsys):
+    out = tmp_path / "eval.json"
+    ckpt = trained_run / "checkpoints" / "latest.pt"
+    assert main(["eval", "--checkpoint", str(ckpt), "--episodes", "3", "--out", str(out)]) == 0
+    printed = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    written = json.loads(out.read_text())
+    assert printed["episodes"] == 3 and len(written["per_episode"]["bounces"]) == 3
+    assert {"return_mean", "return_std", "bounces_mean", "length_mean"} <= printed.keys()
+
+
+def test_play_writes_an_mp4_with_one_frame_per_step(trained_run, tmp_path):
+    video = tmp_path / "play.mp4"
+    ckpt = trained_run / "checkpoints" / "latest.pt"
+    assert main(["play", "--checkpoint", str(ckpt), "--video", str(video), "--video_length", "20"]) == 0
+    frames = [frame for frame in imageio.get_reader(str(video), format="FFMPEG")]  # noqa: C416 (len() is inf)
+    assert len(frames) == 20 and frames[0].shape == (480, 640, 3)
+    assert frames[0].std() > 5  # an actual picture, not a blank frame
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["train", "--task", "juggle", "--steps", "16"], "unknown task 'juggle'"),
+        (["train", "--steps", "16", "ppo.learning_rate=1"], "unknown config key 'ppo.learning_rate'"),
+        (["train", "--obs", "xray", "--steps", "16"], "xray"),
+        (["eval", "--checkpoint", "missing/latest.pt"], "does not exist"),
+        (["play", "--checkpoint", "missing/latest.pt"], "does not exist"),
+        (["train", "--resume", "missing_run"], "not a roto run directory"),
+    ],
+)
+def test_bad_input_is_a_clear_error(args, message, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(args) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "runs").exists()  # nothing written for a rejected command
