@@ -7,6 +7,7 @@ an error naming its dotted path; a missing key keeps its default. ``key=value`` 
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import importlib.resources
 import pathlib
@@ -105,10 +106,8 @@ def _coerce(value: Any, annotation: Any, path: str) -> Any:
         return value
     if annotation is float:
         if isinstance(value, str):  # YAML 1.1 reads 1e-3 (no dot) as a string
-            try:
+            with contextlib.suppress(ValueError):
                 value = float(value)
-            except ValueError:
-                pass
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ValueError(f"{path} must be a number, got {value!r}")
         return float(value)

@@ -32,9 +32,9 @@ def test_wrong_types_are_errors():
 def test_overrides_apply_and_validate():
     cfg = load_agent_config("bounce", overrides=["ppo.lr=1e-3", "network.encoder=[8, 8]"])
     assert cfg.ppo.lr == 1e-3 and cfg.network.encoder == (8, 8)
-    with pytest.raises(ValueError, match="section.key=value"):
+    with pytest.raises(ValueError, match=r"section\.key=value"):
         apply_overrides({}, ["ppo.lr"])
-    with pytest.raises(ValueError, match="ppo.rollouts must be >= 1"):
+    with pytest.raises(ValueError, match=r"ppo\.rollouts must be >= 1"):
         load_agent_config("bounce", overrides=["ppo.rollouts=0"])
 
 

@@ -19,7 +19,7 @@ def test_gae_with_lambda_one_is_the_discounted_return_minus_value():
     rewards = torch.tensor([[1.0, 0.0], [1.0, 1.0], [1.0, 2.0]])
     values = torch.zeros(3, 2)
     dones = torch.zeros(3, 2, dtype=torch.bool)
-    adv, ret = compute_gae(rewards, values, dones, torch.tensor([10.0, 0.0]), gamma=0.5, lam=1.0)
+    _, ret = compute_gae(rewards, values, dones, torch.tensor([10.0, 0.0]), gamma=0.5, lam=1.0)
     assert ret[0].tolist() == pytest.approx([1 + 0.5 + 0.25 + 0.125 * 10, 0 + 0.5 + 0.5])
 
 
