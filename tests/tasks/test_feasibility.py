@@ -41,3 +41,10 @@ def test_baoding_balls_on_their_targets_stay_within_1cm_for_600_steps():
     trace = _hold("baoding", [targets[0], targets[1]])
     deviation = np.linalg.norm(trace - targets[None], axis=-1)
     assert deviation.max() < 0.01, deviation.max()
+
+
+def test_scripted_policy_averages_at_least_10_bounces_over_8_seeds():
+    from roto.scripted import run_scripted_bounce
+
+    per_seed = [run_scripted_bounce(num_envs=8, seed=seed)["mean_bounces"] for seed in range(8)]
+    assert sum(per_seed) / len(per_seed) >= 10.0, per_seed
