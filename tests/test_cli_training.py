@@ -98,3 +98,17 @@ def test_bad_input_is_a_clear_error(args, message, capsys, tmp_path, monkeypatch
     assert main(args) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "runs").exists()  # nothing written for a rejected command
+
+
+def test_train_draws_the_learning_curve(trained_run):
+    from roto.eval.plots import plot_learning_curve, read_scalars
+
+    series = read_scalars(trained_run)
+    assert "ppo/lr" in series and len(series["ppo/lr"][0]) >= 3
+    if "eval/return_mean" in series:  # evaluation rounds closed: the trainer drew the curve
+        assert (trained_run / "learning_curve.png").stat().st_size > 1000
+    csv_path = trained_run / "scalars.csv"
+    with csv_path.open("a") as f:  # a synthetic closed round always gives a figure
+        f.write("100,9,eval/return_mean,5\n100,9,eval/return_std,1\n100,9,eval/bounces_mean,0.5\n")
+    out = plot_learning_curve(trained_run, trained_run / "curve.png")
+    assert out is not None and out.stat().st_size > 1000

@@ -160,6 +160,7 @@ class Trainer:
         self.obs: torch.Tensor | None = None
         self.eval_obs: torch.Tensor | None = None
         self.tensorboard = tensorboard
+        self.plot = tensorboard  # quick tests turn both off
         write_run_config(self.run_dir, settings, agent)
 
     @property
@@ -269,6 +270,10 @@ class Trainer:
         finally:
             bar.close()
             logger.close()
+        if self.plot:
+            from roto.eval.plots import plot_learning_curve
+
+            plot_learning_curve(self.run_dir)
         return dict(self.last_eval)
 
     def _on_eval_round(self, stats: dict[str, float]) -> None:
