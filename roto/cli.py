@@ -124,6 +124,14 @@ def _cmd_play(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_render(args: argparse.Namespace) -> int:
+    from roto.eval.video import render_scene
+
+    path = render_scene(args.task, args.robot, args.out, settle_steps=args.settle_steps, seed=args.seed)
+    print(json.dumps({"task": args.task, "robot": args.robot, "image": str(path)}))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``roto`` argument parser."""
     parser = argparse.ArgumentParser(prog="roto", description="roto: the Robot Tactile Olympiad on MuJoCo")
@@ -164,6 +172,14 @@ def build_parser() -> argparse.ArgumentParser:
     p_play.add_argument("--seed", type=int, default=0)
     p_play.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; always headless")
     p_play.set_defaults(func=_cmd_play)
+
+    p_render = sub.add_parser("render", help="a PNG of a hand in a task scene (offscreen, no display needed)")
+    p_render.add_argument("--task", default="bounce")
+    p_render.add_argument("--robot", default="shadow")
+    p_render.add_argument("--out", default="scene.png")
+    p_render.add_argument("--settle_steps", "--settle-steps", dest="settle_steps", type=int, default=60)
+    p_render.add_argument("--seed", type=int, default=0)
+    p_render.set_defaults(func=_cmd_render)
 
     p_list = sub.add_parser("list", help="every (task, robot) pair with its observation and action sizes")
     p_list.set_defaults(func=_cmd_list)

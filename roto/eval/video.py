@@ -15,7 +15,8 @@ from roto.envs.roto_env import RotoEnv
 from roto.rl.networks import ActorCritic
 from roto.rl.runner import TrainSettings, flatten_obs
 
-TOUCH_RGBA = np.array([0.1, 0.9, 0.2, 1.0], dtype=np.float32)
+TOUCH_RGBA = np.array([0.0, 0.85, 1.0, 1.0], dtype=np.float32)
+"""Colour of a tactile link while its bit is on (cyan)."""
 FPS = 60
 """One frame per control step (60 Hz), so the video plays in real time."""
 
@@ -98,3 +99,38 @@ def record_video(
         renderer.close()
         env.close()
     return {"frames": frames, "episodes": finished}
+
+
+def render_scene(
+    task: str,
+    robot: str,
+    path: str | pathlib.Path,
+    settle_steps: int = 60,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+) -> pathlib.Path:
+    """A PNG of ``robot`` in ``task``'s scene after ``settle_steps`` steps holding the default pose.
+
+    The hand holds its default (cupped) pose with no reset noise, so the picture shows where the
+    objects come to rest; touching links are drawn in the contact colour.
+    """
+    import imageio.v2 as imageio
+
+    from roto.envs.config import EnvConfig
+
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    env = RotoEnv(EnvConfig(task=task, robot=robot, num_envs=1, seed=seed, reset_joint_noise=0.0))
+    env.reset(seed=seed)
+    idx = env._idx
+    hold = 2.0 * (idx.default_qpos[0, idx.act_qpos] - idx.ctrl_lo) / (idx.ctrl_hi - idx.ctrl_lo) - 1.0
+    for _ in range(settle_steps):
+        env.step(hold[None].to(torch.float32))
+    renderer = TactileFrameRenderer(env, width, height)
+    try:
+        imageio.imwrite(path, renderer.render())
+    finally:
+        renderer.close()
+        env.close()
+    return path
