@@ -1,17 +1,18 @@
 """A scripted Bounce policy that reads the ball state: the "how many bounces can this hand do" reference.
 
-The policy is a three-phase catch-and-throw cycle per env, acting on one wrist joint (positive =
-palm and fingers up) while the other joints hold a fixed catching pose:
+The policy is a three-phase catch-and-throw cycle per env, acting on a few "swing" joints (the
+Shadow's wrist; the Lite's fingers, which have no wrist) while the other joints hold a fixed
+catching pose:
 
 * ``HOLD``: the wrist waits at the catch angle until the ball is on the hand and barely moving
   vertically for two steps (a caught ball, not necessarily a still one);
-* ``WIND_UP``: the wrist swings down for a fixed number of steps, which also rolls the ball
-  towards the fingers, out on the longer lever of the wrist;
-* ``STRIKE``: the wrist swings up for a fixed number of steps and throws the ball, then ``HOLD``
-  catches it.
+* ``WIND_UP``: the swing joints move to their wind-up angles for a fixed number of steps (on the
+  Shadow this also rolls the ball towards the fingers, out on the longer lever of the wrist);
+* ``STRIKE``: they move to their strike angles for a fixed number of steps and throw the ball,
+  then ``HOLD`` catches it.
 
-Wind-up and strike angles lean with the ball's offset from the palm centre along the fingers (x),
-which keeps the ball over the palm. The numbers were found by a local search over the parameters
+Wind-up and strike angles may lean with the ball's offset from the palm centre along the fingers
+(x), which keeps the ball over the palm. The numbers were found by a local search over the parameters
 on 16 envs and checked on 8 fresh seeds (docs/robots.md).
 """
 
@@ -32,15 +33,12 @@ HOLD, WIND_UP, STRIKE = 0, 1, 2
 class BounceScript:
     """Parameters of the scripted Bounce policy for one robot (angles in rad, lengths in m)."""
 
-    wrist_joint: str
+    swing: dict[str, tuple[float, float, float]]
+    """Swing joint -> (hold, wind-up, strike) target angles."""
+    lean: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """Swing joint -> change of its (wind-up, strike) angle per metre of ball x offset from ``centre_x``."""
     pose: dict[str, float] = field(default_factory=dict)
-    """Targets of the other joints (by joint name) during the whole episode; the rest keep the default pose."""
-    hold: float
-    wind_up: float
-    strike: float
-    lean_wind_up: float
-    """Wind-up angle change per metre of ball x offset from ``centre_x``."""
-    lean_strike: float
+    """Targets of other joints during the whole episode; the rest keep the default pose."""
     centre_x: float
     wind_up_steps: int
     strike_steps: int
@@ -49,7 +47,8 @@ class BounceScript:
 
 
 SHADOW_BOUNCE = BounceScript(
-    wrist_joint="robot0:WRJ0",
+    swing={"robot0:WRJ0": (0.029, -0.663, 0.337)},
+    lean={"robot0:WRJ0": (2.86, 5.66)},
     pose={
         "robot0:FFJ2": 0.439,
         "robot0:MFJ2": 0.439,
@@ -62,11 +61,6 @@ SHADOW_BOUNCE = BounceScript(
         "robot0:THJ4": 1.102,
         "robot0:THJ3": 0.268,
     },
-    hold=0.029,
-    wind_up=-0.663,
-    strike=0.337,
-    lean_wind_up=2.86,
-    lean_strike=5.66,
     centre_x=0.0078,
     wind_up_steps=4,
     strike_steps=6,
@@ -83,6 +77,7 @@ class ScriptedBounce:
     """
 
     def __init__(self, env: RotoEnv, script: BounceScript | None = None) -> None:
+        """``script`` defaults to the robot's entry in ``SCRIPTS``."""
         if "privileged" not in env.groups or "tactile" not in env.groups:
             raise ValueError(f"the scripted policy needs obs_mode='state', got {env.config.obs_mode!r}")
         if script is None:
@@ -96,7 +91,11 @@ class ScriptedBounce:
         self._pose = idx.default_qpos[0, idx.act_qpos].clone()
         for joint, angle in script.pose.items():
             self._pose[joints.index(joint)] = angle
-        self._wrist = joints.index(script.wrist_joint)
+        self._swing = torch.tensor([joints.index(j) for j in script.swing], dtype=torch.int64)
+        angles = torch.tensor(list(script.swing.values()), dtype=torch.float64)  # (n_swing, 3)
+        self._hold, self._wind_up, self._strike = angles.unbind(1)
+        leans = torch.tensor([script.lean.get(j, (0.0, 0.0)) for j in script.swing], dtype=torch.float64)
+        self._lean_wind_up, self._lean_strike = leans.unbind(1)
         self._n_links = env.frame_sizes["tactile"]
         self._n_priv = env.frame_sizes["privileged"]
         n = env.num_envs
@@ -128,25 +127,31 @@ class ScriptedBounce:
         self._enter((self.phase == WIND_UP) & (self.timer >= s.wind_up_steps), STRIKE)
         self._enter((self.phase == STRIKE) & (self.timer >= s.strike_steps), HOLD)
 
-        offset = x - s.centre_x
-        wrist = torch.full_like(x, s.hold)
-        wrist = torch.where(self.phase == WIND_UP, s.wind_up + s.lean_wind_up * offset, wrist)
-        wrist = torch.where(self.phase == STRIKE, s.strike + s.lean_strike * offset, wrist)
+        offset = (x - s.centre_x)[:, None]
+        phase = self.phase[:, None]
+        swing = self._hold.expand(len(x), -1)
+        swing = torch.where(phase == WIND_UP, self._wind_up + self._lean_wind_up * offset, swing)
+        swing = torch.where(phase == STRIKE, self._strike + self._lean_strike * offset, swing)
         target = self._pose.expand(len(x), -1).clone()
-        target[:, self._wrist] = wrist
+        target[:, self._swing] = swing
         target = torch.minimum(torch.maximum(target, self._lo), self._hi)
         return (2.0 * (target - self._lo) / (self._hi - self._lo) - 1.0).to(torch.float32)
 
 
 def run_scripted_bounce(
-    robot: str = "shadow", num_envs: int = 8, seed: int = 0, episodes: int = 1, progress: bool = False
+    robot: str = "shadow",
+    num_envs: int = 8,
+    seed: int = 0,
+    episodes: int = 1,
+    progress: bool = False,
+    script: BounceScript | None = None,
 ) -> dict[str, float]:
     """Run the scripted policy until each env has finished ``episodes`` episodes; bounce statistics.
 
     Each env contributes exactly its first ``episodes`` episodes, so short episodes are not favoured.
     """
     env = make("bounce", robot=robot, num_envs=num_envs, obs_mode="state", seed=seed)
-    policy = ScriptedBounce(env)
+    policy = ScriptedBounce(env, script)
     obs, _ = env.reset(seed=seed)
     per_env: list[list[tuple[float, float]]] = [[] for _ in range(num_envs)]
     with tqdm(total=episodes * num_envs, disable=not progress, desc="scripted bounce episodes") as bar:

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from roto.robots.shadow import SHADOW
+from roto.robots.shadow_lite import SHADOW_LITE
 from roto.robots.spec import Gains, RobotSpec
 
-ROBOTS: dict[str, RobotSpec] = {SHADOW.name: SHADOW}
+ROBOTS: dict[str, RobotSpec] = {robot.name: robot for robot in (SHADOW, SHADOW_LITE)}
 
 __all__ = ["ROBOTS", "Gains", "RobotSpec", "get_robot"]
 

@@ -95,10 +95,21 @@ def pose_root_in_task_frame(spec: mujoco.MjSpec, robot: RobotSpec) -> None:
     mujoco.mj_kinematics(model, data)
     centre_w, rot_w = palm_frame(model, data, robot)
     # Root is at the world origin with identity orientation, so world = root frame here.
+    tilt = _tilt_rotation(*robot.palm_tilt)
+    rotation = tilt @ rot_w
     quat = np.zeros(4)
-    mujoco.mju_mat2Quat(quat, rot_w.flatten())
+    mujoco.mju_mat2Quat(quat, rotation.flatten())
     root.quat = quat
-    root.pos = -rot_w @ centre_w
+    root.pos = -rotation @ centre_w
+
+
+def _tilt_rotation(about_x: float, about_y: float) -> np.ndarray:
+    """R_y(about_y) @ R_x(about_x): positive about_y lowers +x, positive about_x lowers -y."""
+    cx, sx = np.cos(about_x), np.sin(about_x)
+    cy, sy = np.cos(about_y), np.sin(about_y)
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, cx, -sx], [0.0, sx, cx]])
+    ry = np.array([[cy, 0.0, sy], [0.0, 1.0, 0.0], [-sy, 0.0, cy]])
+    return ry @ rx
 
 
 def add_exclusions(spec: mujoco.MjSpec, robot: RobotSpec) -> None:

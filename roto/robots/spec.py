@@ -44,6 +44,10 @@ class RobotSpec:
         coupled_joints: driven joint -> (driving joint, ratio): the model couples them (tendon or
             equality); resets set driven = ratio * driving so no coupling starts violated.
         excluded_contacts: body pairs whose contacts are filtered out.
+        palm_tilt: (about x, about y) rotation (rad) of the whole hand about the palm centre after
+            it is posed palm-up, for hands whose palm alone cannot cradle a ball (e.g. a hand with
+            no little finger). Positive y tilts the fingertips down; positive x lowers the side
+            of the first finger (the thumb side).
     """
 
     name: str
@@ -62,6 +66,7 @@ class RobotSpec:
     baoding_targets: tuple[tuple[float, float, float], tuple[float, float, float]]
     coupled_joints: Mapping[str, tuple[str, float]] = field(default_factory=dict)
     excluded_contacts: tuple[tuple[str, str], ...] = field(default=())
+    palm_tilt: tuple[float, float] = (0.0, 0.0)
 
     def gains_for(self, joint: str) -> Gains:
         """The gains of one actuated joint: the first key of ``gains`` contained in its name."""

@@ -2,19 +2,18 @@
 
 import mujoco
 import numpy as np
+import pytest
 
-from roto.robots import get_robot
+from roto.robots import ROBOTS, get_robot
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
 from roto.tasks.base import PALM_DROP_LIMIT
 from roto.tasks.bounce import HORIZONTAL_LIMIT, SPAWN_HEIGHT
 
-SHADOW = get_robot("shadow")
 
-
-def _hold(task_name: str, starts: list[np.ndarray], steps: int = 600):
+def _hold(robot, task_name: str, starts: list[np.ndarray], steps: int = 600):
     task = get_task(task_name)
-    model, layout = build_scene(SHADOW, task.balls(SHADOW))
+    model, layout = build_scene(robot, task.balls(robot))
     data = mujoco.MjData(model)
     data.qpos[:] = layout.default_qpos
     for adr, start in zip(layout.ball_qpos, starts, strict=True):
@@ -27,18 +26,21 @@ def _hold(task_name: str, starts: list[np.ndarray], steps: int = 600):
     return np.array(trace)  # (steps, n_ball, 3)
 
 
-def test_dropped_bounce_ball_comes_to_rest_without_termination():
-    for offset in ([0, 0], [0.01, 0.01], [-0.01, -0.01], [0.01, -0.01]):
-        trace = _hold("bounce", [np.array([*offset, SPAWN_HEIGHT])])
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_dropped_bounce_ball_comes_to_rest_without_termination(name):
+    for offset in ([0, 0], [0.01, 0.01], [-0.01, -0.01], [0.01, -0.01], [-0.01, 0.01]):
+        trace = _hold(get_robot(name), "bounce", [np.array([*offset, SPAWN_HEIGHT])])
         ball = trace[:, 0]
         assert ball[:, 2].min() > -PALM_DROP_LIMIT
         assert np.linalg.norm(ball[:, :2], axis=1).max() < HORIZONTAL_LIMIT
         assert np.linalg.norm(ball[-1] - ball[-60]) < 1e-3  # at rest over the last second
 
 
-def test_baoding_balls_on_their_targets_stay_within_1cm_for_600_steps():
-    targets = np.array(SHADOW.baoding_targets)
-    trace = _hold("baoding", [targets[0], targets[1]])
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_baoding_balls_on_their_targets_stay_within_1cm_for_600_steps(name):
+    robot = get_robot(name)
+    targets = np.array(robot.baoding_targets)
+    trace = _hold(robot, "baoding", [targets[0], targets[1]])
     deviation = np.linalg.norm(trace - targets[None], axis=-1)
     assert deviation.max() < 0.01, deviation.max()
 
