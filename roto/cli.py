@@ -21,12 +21,12 @@ def _cmd_list(args: argparse.Namespace) -> int:
     import roto
     from roto.registry import gym_id
 
-    print(f"{'task':<9} {'robot':<8} {'gymnasium id':<26} {'actions':>7} {'frame (blind)':>13} {'stacked':>8}")
+    print(f"{'task':<9} {'robot':<12} {'gymnasium id':<30} {'actions':>7} {'frame (blind)':>13} {'stacked':>8}")
     for task, robot in roto.list_envs():
         env = roto.make(task, robot=robot, num_envs=1)
         frame = sum(env.frame_sizes.values())
         stacked = frame * env.config.frame_stack
-        print(f"{task:<9} {robot:<8} {gym_id(task, robot):<26} {env.num_actions:>7} {frame:>13} {stacked:>8}")
+        print(f"{task:<9} {robot:<12} {gym_id(task, robot):<30} {env.num_actions:>7} {frame:>13} {stacked:>8}")
         env.close()
     return 0
 
