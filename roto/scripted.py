@@ -67,7 +67,24 @@ SHADOW_BOUNCE = BounceScript(
     settle_speed=0.25,
 )
 
-SCRIPTS: dict[str, BounceScript] = {"shadow": SHADOW_BOUNCE}
+# The Lite has no wrist: its fingers extend (wind-up: the ball rolls out onto them, the hand being
+# tilted towards the fingertips), then flick up at the knuckles (J2) and middle joints (J1) while
+# the thumb (THJ3) swings up beside them.
+SHADOW_LITE_BOUNCE = BounceScript(
+    swing={
+        **{f"robot0:{f}J2": (0.223, 0.033, 1.504) for f in ("FF", "MF", "RF")},
+        **{f"robot0:{f}J1": (0.288, 0.0, 0.8) for f in ("FF", "MF", "RF")},
+        "robot0:THJ3": (0.197, 0.298, 0.986),
+    },
+    lean={f"robot0:{f}J2": (1.204, -3.184) for f in ("FF", "MF", "RF")},
+    pose={"robot0:THJ4": 0.665, "robot0:RFJ3": -0.31},
+    centre_x=0.03,
+    wind_up_steps=10,
+    strike_steps=4,
+    settle_speed=0.088,
+)
+
+SCRIPTS: dict[str, BounceScript] = {"shadow": SHADOW_BOUNCE, "shadow_lite": SHADOW_LITE_BOUNCE}
 
 
 class ScriptedBounce:
