@@ -84,7 +84,23 @@ SHADOW_LITE_BOUNCE = BounceScript(
     settle_speed=0.088,
 )
 
-SCRIPTS: dict[str, BounceScript] = {"shadow": SHADOW_BOUNCE, "shadow_lite": SHADOW_LITE_BOUNCE}
+# ORCA's wrist is strong (kp 100): it winds the fingers down (positive wrist) and strikes back up.
+ORCA_BOUNCE = BounceScript(
+    swing={"right_wrist": (-0.338, 0.661, 0.227)},
+    lean={"right_wrist": (3.112, -2.796)},
+    pose={
+        **{f"right_{f}_mcp": 0.368 for f in ("index", "middle", "ring", "pinky")},
+        **{f"right_{f}_pip": 0.542 for f in ("index", "middle", "ring", "pinky")},
+        "right_thumb_abd": -0.397,
+        "right_thumb_mcp": -0.87,
+    },
+    centre_x=-0.012,
+    wind_up_steps=6,
+    strike_steps=4,
+    settle_speed=0.075,
+)
+
+SCRIPTS: dict[str, BounceScript] = {"shadow": SHADOW_BOUNCE, "shadow_lite": SHADOW_LITE_BOUNCE, "orca": ORCA_BOUNCE}
 
 
 class ScriptedBounce:

@@ -14,6 +14,7 @@ from roto.tasks.baoding import calibrate_targets
 TABLE = {
     "shadow": (24, 20, 17, 97),
     "shadow_lite": (16, 13, 14, 72),
+    "orca": (17, 17, 17, 85),
 }
 
 
