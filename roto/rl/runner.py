@@ -156,6 +156,7 @@ class Trainer:
         self.update = 0
         self.env_steps = 0
         self.best_eval_return = -math.inf
+        self.train_seconds = 0.0  # rollouts + updates so far, summed over resumes (not logging/checkpoints)
         self.last_eval: dict[str, float] = {}
         self.obs: torch.Tensor | None = None
         self.eval_obs: torch.Tensor | None = None
@@ -252,6 +253,8 @@ class Trainer:
                 scalars.update(stats)
                 scalars["perf/update_s"] = t_end - t_update
                 scalars["perf/steps_per_s"] = self.steps_per_update / (t_end - t_start)
+                self.train_seconds += t_end - t_start
+                scalars["perf/train_wall_s"] = self.train_seconds
                 for closed in rounds:
                     self._on_eval_round(closed)
                     scalars.update(closed)
@@ -299,6 +302,7 @@ class Trainer:
             "update": self.update,
             "env_steps": self.env_steps,
             "best_eval_return": self.best_eval_return,
+            "train_seconds": self.train_seconds,
             "last_eval": self.last_eval,
             "train": dataclasses.asdict(self.settings),
             "agent": to_dict(self.agent),
@@ -322,6 +326,7 @@ class Trainer:
         self.eval_rounds.pending = state["eval_pending"]
         self.update, self.env_steps = int(state["update"]), int(state["env_steps"])
         self.best_eval_return = float(state["best_eval_return"])
+        self.train_seconds = float(state.get("train_seconds", 0.0))
         self.last_eval = dict(state["last_eval"])
 
     @classmethod
