@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+from roto.robots.allegro import ALLEGRO
 from roto.robots.orca import ORCA
 from roto.robots.shadow import SHADOW
 from roto.robots.shadow_lite import SHADOW_LITE
 from roto.robots.spec import Gains, RobotSpec
 
-ROBOTS: dict[str, RobotSpec] = {robot.name: robot for robot in (SHADOW, SHADOW_LITE, ORCA)}
+ROBOTS: dict[str, RobotSpec] = {robot.name: robot for robot in (SHADOW, SHADOW_LITE, ALLEGRO, ORCA)}
 
 __all__ = ["ROBOTS", "Gains", "RobotSpec", "get_robot"]
 

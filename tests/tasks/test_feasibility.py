@@ -49,7 +49,15 @@ def test_baoding_balls_on_their_targets_stay_within_1cm_for_600_steps(name):
 SCRIPTED_MINIMUM = {"shadow": 10.0, "shadow_lite": 5.0, "orca": 5.0}
 
 
-@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_every_hand_but_allegro_has_a_bounce_script():
+    # Allegro's scripted Bounce is still open (docs/robots.md); this fails once someone adds one,
+    # as a reminder to add it to SCRIPTED_MINIMUM below.
+    from roto.scripted import SCRIPTS
+
+    assert set(ROBOTS) - set(SCRIPTS) == {"allegro"}
+
+
+@pytest.mark.parametrize("name", sorted(SCRIPTED_MINIMUM))
 def test_scripted_policy_bounces_the_ball_over_8_seeds(name):
     from roto.scripted import run_scripted_bounce
 
