@@ -2,28 +2,31 @@ import numpy as np
 import pytest
 import torch
 
+from roto.registry import list_envs
 from tests.conftest import make_env
 
-SIZES = {"blind": {"tactile": 17, "proprio": 80}, "state": {"tactile": 17, "proprio": 80}, "proprio": {"proprio": 80}}
+# SPEC §3 per robot: tactile links, proprio = 2 * observed joints + 2 * actions, actions
+TABLE = {"shadow": (17, 80, 20), "shadow_lite": (14, 58, 13), "allegro": (20, 64, 16), "orca": (17, 68, 17)}
 
 
-@pytest.mark.parametrize("task", ["bounce", "baoding"])
+@pytest.mark.parametrize(("task", "robot"), list_envs())
 @pytest.mark.parametrize("obs_mode", ["blind", "state", "proprio"])
-def test_observation_sizes_dtypes_and_spaces(task, obs_mode):
-    env = make_env(task, obs_mode=obs_mode, num_envs=3)
-    expected = dict(SIZES[obs_mode])
+def test_observation_sizes_dtypes_and_spaces(task, robot, obs_mode):
+    env = make_env(task, robot=robot, obs_mode=obs_mode, num_envs=3)
+    tactile, proprio, actions = TABLE[robot]
+    expected = {"tactile": tactile, "proprio": proprio} if obs_mode != "proprio" else {"proprio": proprio}
     if obs_mode == "state":
         expected["privileged"] = 6 if task == "bounce" else 12
     assert env.frame_sizes == expected
     obs, _ = env.reset()
-    obs2, reward, terminated, truncated, _ = env.step(torch.zeros(3, 20))
+    obs2, reward, terminated, truncated, _ = env.step(torch.zeros(3, actions))
     for o in (obs, obs2):
         assert list(o) == list(expected)
         for name, value in o.items():
             assert value.dtype == torch.float32 and value.shape == (3, 4 * expected[name])
             assert env.observation_space[name].contains(value[0].numpy())
     assert reward.shape == (3,) and terminated.dtype == torch.bool and truncated.dtype == torch.bool
-    assert env.action_space.shape == (20,)
+    assert env.action_space.shape == (actions,)
     env.close()
 
 
