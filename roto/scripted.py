@@ -100,7 +100,29 @@ ORCA_BOUNCE = BounceScript(
     settle_speed=0.075,
 )
 
-SCRIPTS: dict[str, BounceScript] = {"shadow": SHADOW_BOUNCE, "shadow_lite": SHADOW_LITE_BOUNCE, "orca": ORCA_BOUNCE}
+# The Allegro has no wrist either: its fingers curl the ball up from the palm (j2 straightens from
+# 1.23 to 0.32 while j1 rises and j3 flicks up) and the thumb swings up beside it (thj2).
+ALLEGRO_BOUNCE = BounceScript(
+    swing={
+        **{f"{f}j1": (0.211, 0.173, 0.472) for f in ("ff", "mf", "rf")},
+        **{f"{f}j2": (1.6, 1.231, 0.324) for f in ("ff", "mf", "rf")},
+        **{f"{f}j3": (0.681, -0.052, 1.04) for f in ("ff", "mf", "rf")},
+        "thj2": (0.674, 0.397, 1.64),
+    },
+    lean={f"{f}j1": (-6.244, -8.267) for f in ("ff", "mf", "rf")},
+    pose={"thj0": 0.325, "thj1": 0.079},
+    centre_x=-0.007,
+    wind_up_steps=2,
+    strike_steps=9,
+    settle_speed=0.346,
+)
+
+SCRIPTS: dict[str, BounceScript] = {
+    "shadow": SHADOW_BOUNCE,
+    "shadow_lite": SHADOW_LITE_BOUNCE,
+    "allegro": ALLEGRO_BOUNCE,
+    "orca": ORCA_BOUNCE,
+}
 
 
 class ScriptedBounce:

@@ -46,15 +46,13 @@ def test_baoding_balls_on_their_targets_stay_within_1cm_for_600_steps(name):
 
 
 # Issue thresholds: the Shadow >= 10 bounces per 10 s episode, every other hand >= 5.
-SCRIPTED_MINIMUM = {"shadow": 10.0, "shadow_lite": 5.0, "orca": 5.0}
+SCRIPTED_MINIMUM = {"shadow": 10.0, "shadow_lite": 5.0, "allegro": 5.0, "orca": 5.0}
 
 
-def test_every_hand_but_allegro_has_a_bounce_script():
-    # Allegro's scripted Bounce is still open (docs/robots.md); this fails once someone adds one,
-    # as a reminder to add it to SCRIPTED_MINIMUM below.
+def test_every_hand_has_a_bounce_script_and_a_threshold():
     from roto.scripted import SCRIPTS
 
-    assert set(ROBOTS) - set(SCRIPTS) == {"allegro"}
+    assert set(ROBOTS) == set(SCRIPTS) == set(SCRIPTED_MINIMUM)
 
 
 @pytest.mark.parametrize("name", sorted(SCRIPTED_MINIMUM))
