@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import torch
 from tqdm import tqdm
 
+from roto.envs.control import target_to_action
 from roto.envs.roto_env import RotoEnv
 from roto.registry import make
 
@@ -190,7 +191,7 @@ class ScriptedBounce:
         target = self._pose.expand(len(x), -1).clone()
         target[:, self._swing] = swing
         target = torch.minimum(torch.maximum(target, self._lo), self._hi)
-        return (2.0 * (target - self._lo) / (self._hi - self._lo) - 1.0).to(torch.float32)
+        return target_to_action(target, self._lo, self._hi)
 
 
 def run_scripted_bounce(

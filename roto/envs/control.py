@@ -23,3 +23,16 @@ def smooth_target(target: torch.Tensor, previous: torch.Tensor, alpha: float) ->
     if alpha == 1.0:
         return target
     return alpha * target + (1.0 - alpha) * previous
+
+
+def target_to_action(target: torch.Tensor, lo: torch.Tensor, hi: torch.Tensor) -> torch.Tensor:
+    """The action that ``action_to_target`` maps to ``target``: 2 (q* - lo) / (hi - lo) - 1, float32.
+
+    Args:
+        target: (..., n) joint targets (rad).
+        lo, hi: (n,) joint limits of the actuated joints.
+
+    Returns:
+        (..., n) actions in [-1, 1] for targets within the limits.
+    """
+    return (2.0 * (target - lo) / (hi - lo) - 1.0).to(torch.float32)

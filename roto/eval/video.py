@@ -11,6 +11,7 @@ import mujoco
 import numpy as np
 import torch
 
+from roto.envs.control import target_to_action
 from roto.envs.roto_env import RotoEnv
 from roto.rl.networks import ActorCritic
 from roto.rl.runner import TrainSettings, flatten_obs
@@ -124,9 +125,9 @@ def render_scene(
     env = RotoEnv(EnvConfig(task=task, robot=robot, num_envs=1, seed=seed, reset_joint_noise=0.0))
     env.reset(seed=seed)
     idx = env._idx
-    hold = 2.0 * (idx.default_qpos[0, idx.act_qpos] - idx.ctrl_lo) / (idx.ctrl_hi - idx.ctrl_lo) - 1.0
+    hold = target_to_action(idx.default_qpos[:, idx.act_qpos], idx.ctrl_lo, idx.ctrl_hi)
     for _ in range(settle_steps):
-        env.step(hold[None].to(torch.float32))
+        env.step(hold)
     renderer = TactileFrameRenderer(env, width, height)
     try:
         imageio.imwrite(path, renderer.render())

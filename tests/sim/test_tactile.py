@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 import torch
 
+from roto.envs.control import target_to_action
 from roto.envs.observations import tactile_bits
 from roto.robots import ROBOTS, get_robot
 from roto.sim.scene import BallSpec, build_scene
@@ -33,12 +34,8 @@ def test_bits_clear_within_one_step_after_the_ball_leaves(name):
     obs, _ = env.reset()
     for _ in range(30):
         obs, *_ = env.step(torch.zeros(1, env.num_actions))
-    hold = torch.from_numpy(
-        2
-        * (env._idx.default_qpos[0, env._idx.act_qpos].numpy() - env._idx.ctrl_lo.numpy())
-        / (env._idx.ctrl_hi - env._idx.ctrl_lo).numpy()
-        - 1
-    ).float()[None]
+    idx = env._idx
+    hold = target_to_action(idx.default_qpos[:, idx.act_qpos], idx.ctrl_lo, idx.ctrl_hi)
     env.reset()
     for _ in range(30):
         obs, *_ = env.step(hold)
