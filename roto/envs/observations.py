@@ -89,6 +89,14 @@ class FrameStack:
         for name, value in frame.items():
             self._frames[name] = torch.cat([self._frames[name][:, 1:], value[:, None, :]], dim=1)
 
+    def state_dict(self) -> dict[str, torch.Tensor]:
+        """Copies of the stacked frames, (B, k, dim) per group."""
+        return {name: frames.clone() for name, frames in self._frames.items()}
+
+    def load_state_dict(self, state: dict[str, torch.Tensor]) -> None:
+        """Restore what ``state_dict`` returned."""
+        self._frames = {name: frames.clone() for name, frames in state.items()}
+
     def observation(self) -> dict[str, torch.Tensor]:
         """(B, k·dim) per group; fresh tensors each step, never views of internal buffers."""
         return {name: frames.flatten(1).clone() for name, frames in self._frames.items()}

@@ -150,7 +150,7 @@ class RotoEnv:
         return {
             "physics": torch.from_numpy(self.backend.state.copy()),
             "task": {f.name: getattr(self.task_state, f.name).clone() for f in dataclasses.fields(self.task_state)},
-            "frames": {name: value.clone() for name, value in self._stack._frames.items()},
+            "frames": self._stack.state_dict(),
             "episode_length": self._episode.length.clone(),
             "episode_return": self._episode.ret.clone(),
             "term_sums": {name: value.clone() for name, value in self._term_sums.items()},
@@ -172,7 +172,7 @@ class RotoEnv:
         self.backend.state[:] = physics
         for name, value in state["task"].items():
             setattr(self.task_state, name, value.clone().to(self.device))
-        self._stack._frames = {name: value.clone().to(self.device) for name, value in state["frames"].items()}
+        self._stack.load_state_dict({name: value.to(self.device) for name, value in state["frames"].items()})
         self._episode.length = state["episode_length"].clone().to(self.device)
         self._episode.ret = state["episode_return"].clone().to(self.device)
         self._term_sums = {name: value.clone().to(self.device) for name, value in state["term_sums"].items()}
