@@ -60,12 +60,12 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    import dataclasses
     import pathlib
     import time
 
     import torch
 
+    from roto.envs.config import EnvConfig
     from roto.rl.config import load_agent_config
     from roto.rl.runner import Trainer, TrainSettings
 
@@ -73,17 +73,16 @@ def _cmd_train(args: argparse.Namespace) -> int:
     if args.resume:
         trainer = Trainer.resume(args.resume, total_steps=args.steps)
     else:
-        settings = TrainSettings(
+        env = EnvConfig(  # validates task / robot / obs mode / backend before anything is written
             task=args.task,
             robot=args.robot,
             obs_mode=args.obs,
             num_envs=args.num_envs,
-            total_steps=args.steps if args.steps is not None else 1_000_000,
             seed=args.seed,
             backend=args.backend,
             threads=args.threads,
         )
-        settings.env_config()  # validate task / robot / obs mode / backend before anything is written
+        settings = TrainSettings(env=env, total_steps=args.steps if args.steps is not None else 1_000_000)
         agent = load_agent_config(args.task, args.agent_cfg, args.overrides)
         run_dir = args.run_dir or pathlib.Path("runs") / (
             f"{args.task}_{args.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{args.seed}"
@@ -93,7 +92,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
     last = trainer.train(progress=not args.no_progress)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
     summary.update({k.removeprefix("eval/"): v for k, v in last.items()})
-    summary["settings"] = dataclasses.asdict(trainer.settings)
+    summary["settings"] = trainer.settings.to_dict()
     print(json.dumps(summary))
     return 0
 
@@ -106,7 +105,7 @@ def _cmd_eval(args: argparse.Namespace) -> int:
 
     model, settings, _ = load_policy(args.checkpoint)
     result = evaluate(model, settings, episodes=args.episodes, seed=args.seed)
-    result = {"checkpoint": str(args.checkpoint), "task": settings.task, "robot": settings.robot, **result}
+    result = {"checkpoint": str(args.checkpoint), "task": settings.env.task, "robot": settings.env.robot, **result}
     out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
     out.write_text(json.dumps(result, indent=1))
     print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))

@@ -30,30 +30,24 @@ EVAL_SEED_OFFSET = 10_000
 
 @dataclass(frozen=True, kw_only=True)
 class TrainSettings:
-    """What a training run trains on, besides the agent config."""
+    """What a training run trains on (the training envs' config) and for how many env steps."""
 
-    task: str = "bounce"
-    robot: str = "shadow"
-    obs_mode: str = "blind"
-    num_envs: int = 64
+    env: EnvConfig
     total_steps: int = 1_000_000
-    seed: int = 0
-    backend: str = "cpu"
-    device: str = "cpu"
-    threads: int = 1
 
     def env_config(self, num_envs: int | None = None, seed: int | None = None) -> EnvConfig:
-        """The env config of the training envs (or of evaluation envs with other num_envs / seed)."""
-        return EnvConfig(
-            task=self.task,
-            robot=self.robot,
-            obs_mode=self.obs_mode,
-            num_envs=self.num_envs if num_envs is None else num_envs,
-            seed=self.seed if seed is None else seed,
-            backend=self.backend,
-            device=self.device,
-            threads=self.threads,
-        )
+        """The training envs' config, or that of evaluation envs with another num_envs / seed."""
+        changes = {name: value for name, value in (("num_envs", num_envs), ("seed", seed)) if value is not None}
+        return dataclasses.replace(self.env, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain nested dict (for config.yaml and checkpoints)."""
+        return {"env": dataclasses.asdict(self.env), "total_steps": self.total_steps}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> TrainSettings:
+        """Inverse of ``to_dict``."""
+        return cls(env=EnvConfig(**data["env"]), total_steps=int(data["total_steps"]))
 
 
 def flatten_obs(obs: dict[str, torch.Tensor]) -> torch.Tensor:
@@ -63,7 +57,7 @@ def flatten_obs(obs: dict[str, torch.Tensor]) -> torch.Tensor:
 
 def write_run_config(run_dir: pathlib.Path, settings: TrainSettings, agent: AgentConfig) -> None:
     """The resolved config of a run (what ``--resume`` reads back)."""
-    data = {"train": dataclasses.asdict(settings), "agent": to_dict(agent)}
+    data = {"train": settings.to_dict(), "agent": to_dict(agent)}
     (run_dir / CONFIG_NAME).write_text(yaml.safe_dump(data, sort_keys=False))
 
 
@@ -73,7 +67,7 @@ def read_run_config(run_dir: pathlib.Path) -> tuple[TrainSettings, AgentConfig]:
     if not path.is_file():
         raise FileNotFoundError(f"{str(run_dir)!r} is not a roto run directory (no {CONFIG_NAME})")
     data = yaml.safe_load(path.read_text())
-    return TrainSettings(**data["train"]), from_dict(AgentConfig, data["agent"]).validate()
+    return TrainSettings.from_dict(data["train"]), from_dict(AgentConfig, data["agent"]).validate()
 
 
 def build_model(env: RotoEnv, agent: AgentConfig) -> ActorCritic:
@@ -144,14 +138,14 @@ class Trainer:
         (self.run_dir / CHECKPOINT_DIR).mkdir(parents=True, exist_ok=True)
         self.env = env_factory(settings.env_config())
         self.eval_env = env_factory(
-            settings.env_config(num_envs=agent.run.num_eval_envs, seed=settings.seed + EVAL_SEED_OFFSET)
+            settings.env_config(num_envs=agent.run.num_eval_envs, seed=settings.env.seed + EVAL_SEED_OFFSET)
         )
-        torch.manual_seed(settings.seed)
+        torch.manual_seed(settings.env.seed)
         self.model = build_model(self.env, agent)
         self.ppo = PPO(self.model, agent.ppo)
-        self.generator = torch.Generator().manual_seed(settings.seed)
+        self.generator = torch.Generator().manual_seed(settings.env.seed)
         obs_dim = self.model.encoder[0].in_features
-        self.buffer = RolloutBuffer(agent.ppo.rollouts, settings.num_envs, obs_dim, self.env.num_actions, "cpu")
+        self.buffer = RolloutBuffer(agent.ppo.rollouts, settings.env.num_envs, obs_dim, self.env.num_actions, "cpu")
         self.eval_rounds = EvalRounds(agent.run.num_eval_envs, self.env.task.metric_names)
         self.update = 0
         self.env_steps = 0
@@ -167,7 +161,7 @@ class Trainer:
     @property
     def steps_per_update(self) -> int:
         """Env steps collected per PPO update (rollouts x num_envs)."""
-        return self.agent.ppo.rollouts * self.settings.num_envs
+        return self.agent.ppo.rollouts * self.settings.env.num_envs
 
     @property
     def total_updates(self) -> int:
@@ -178,8 +172,8 @@ class Trainer:
 
     def _start(self) -> None:
         if self.obs is None:
-            self.obs = flatten_obs(self.env.reset(seed=self.settings.seed)[0])
-            self.eval_obs = flatten_obs(self.eval_env.reset(seed=self.settings.seed + EVAL_SEED_OFFSET)[0])
+            self.obs = flatten_obs(self.env.reset(seed=self.settings.env.seed)[0])
+            self.eval_obs = flatten_obs(self.eval_env.reset(seed=self.settings.env.seed + EVAL_SEED_OFFSET)[0])
 
     @torch.no_grad()
     def _collect(self) -> tuple[dict[str, float], list[dict[str, float]]]:
@@ -233,7 +227,7 @@ class Trainer:
             initial=self.env_steps,
             disable=not progress,
             unit="step",
-            desc=f"{self.settings.task}/{self.settings.robot}/{self.settings.obs_mode}",
+            desc=f"{self.settings.env.task}/{self.settings.env.robot}/{self.settings.env.obs_mode}",
         )
         try:
             while self.update < self.total_updates:
@@ -304,7 +298,7 @@ class Trainer:
             "best_eval_return": self.best_eval_return,
             "train_seconds": self.train_seconds,
             "last_eval": self.last_eval,
-            "train": dataclasses.asdict(self.settings),
+            "train": self.settings.to_dict(),
             "agent": to_dict(self.agent),
         }
 
@@ -356,7 +350,7 @@ def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSetti
     if not path.is_file():
         raise FileNotFoundError(f"checkpoint {str(path)!r} does not exist")
     state = torch.load(path, weights_only=False, map_location="cpu")
-    settings = TrainSettings(**state["train"])
+    settings = TrainSettings.from_dict(state["train"])
     agent = from_dict(AgentConfig, state["agent"]).validate()
     env = RotoEnv(settings.env_config(num_envs=1))
     model = build_model(env, agent)

@@ -1,6 +1,7 @@
 import pytest
 import torch
 
+from roto.envs.config import EnvConfig
 from roto.rl.config import load_agent_config
 from roto.rl.runner import Trainer, TrainSettings
 from tests.rl.toy_env import ToyEnv
@@ -17,7 +18,8 @@ TINY = [
 
 
 def tiny_trainer(tmp_path, name, updates, **kwargs):
-    settings = TrainSettings(task="bounce", robot="shadow", num_envs=4, total_steps=16 * updates, seed=3)
+    env = EnvConfig(task="bounce", robot="shadow", num_envs=4, seed=3)
+    settings = TrainSettings(env=env, total_steps=16 * updates)
     agent = load_agent_config("bounce", overrides=TINY)
     return Trainer(settings, agent, tmp_path / name, tensorboard=False, **kwargs)
 
@@ -60,7 +62,7 @@ def test_resume_without_a_checkpoint_is_a_clear_error(tmp_path):
 
 def test_ppo_learns_the_toy_task(tmp_path):
     torch.set_num_threads(1)
-    settings = TrainSettings(num_envs=32, total_steps=32 * 8 * 60, seed=0)
+    settings = TrainSettings(env=EnvConfig(task="bounce", num_envs=32, seed=0), total_steps=32 * 8 * 60)
     agent = load_agent_config(
         "bounce",
         overrides=[
