@@ -21,10 +21,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import torch
-from tqdm import tqdm
 
 from roto.envs.control import target_to_action
 from roto.envs.roto_env import RotoEnv
+from roto.eval.episodes import first_episodes
 from roto.registry import make
 
 HOLD, WIND_UP, STRIKE = 0, 1, 2
@@ -209,24 +209,13 @@ def run_scripted_bounce(
     env = make("bounce", robot=robot, num_envs=num_envs, obs_mode="state", seed=seed)
     policy = ScriptedBounce(env, script)
     obs, _ = env.reset(seed=seed)
-    per_env: list[list[tuple[float, float]]] = [[] for _ in range(num_envs)]
-    with tqdm(total=episodes * num_envs, disable=not progress, desc="scripted bounce episodes") as bar:
-        while min(len(done) for done in per_env) < episodes:
-            obs, _, _, _, info = env.step(policy(obs))
-            if "episode" in info:
-                finished = info["_episode"]
-                policy.reset(finished)
-                for i in torch.nonzero(finished).flatten().tolist():
-                    if len(per_env[i]) < episodes:
-                        per_env[i].append((float(info["episode"]["bounces"][i]), float(info["episode"]["l"][i])))
-                        bar.update(1)
+    result = first_episodes(env, policy, obs, episodes, on_done=policy.reset, progress=progress)
     env.close()
-    results = [r for env_results in per_env for r in env_results]
-    bounces = [b for b, _ in results]
+    bounces = result["bounces"]
     return {
-        "episodes": len(results),
-        "mean_bounces": sum(bounces) / len(bounces),
-        "min_bounces": min(bounces),
-        "max_bounces": max(bounces),
-        "mean_length": sum(length for _, length in results) / len(results),
+        "episodes": bounces.numel(),
+        "mean_bounces": float(bounces.mean()),
+        "min_bounces": float(bounces.min()),
+        "max_bounces": float(bounces.max()),
+        "mean_length": float(result["l"].mean()),
     }
