@@ -66,6 +66,8 @@ THUMB_BOXES = {  # half-sizes, centre
 }
 THUMB_TIP_CAPSULE = (0.012, 0.008, 0.035)
 
+EFFORT = 0.5
+"""Actuator force limit (N·m), roto's Allegro effort."""
 ARMATURE = 0.001
 LINK_RGBA = (0.2, 0.2, 0.2, 1.0)
 TIP_RGBA = (0.9, 0.9, 0.9, 1.0)
@@ -154,9 +156,6 @@ def load_allegro_spec() -> mujoco.MjSpec:
     exclude.bodyname1, exclude.bodyname2 = "palm", "th_proximal"
     return spec
 
-
-EFFORT = 0.5
-"""Actuator force limit (N·m), roto's Allegro effort."""
 
 _ACTUATED = tuple(f"{f}j{i}" for f in ("ff", "mf", "rf", "th") for i in range(4))
 

@@ -95,7 +95,7 @@ def pose_root_in_task_frame(spec: mujoco.MjSpec, robot: RobotSpec) -> None:
     mujoco.mj_kinematics(model, data)
     centre_w, rot_w = palm_frame(model, data, robot)
     # Root is at the world origin with identity orientation, so world = root frame here.
-    tilt = _tilt_rotation(*robot.palm_tilt)
+    tilt = tilt_rotation(*robot.palm_tilt)
     rotation = tilt @ rot_w
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, rotation.flatten())
@@ -103,7 +103,7 @@ def pose_root_in_task_frame(spec: mujoco.MjSpec, robot: RobotSpec) -> None:
     root.pos = -rotation @ centre_w
 
 
-def _tilt_rotation(about_x: float, about_y: float) -> np.ndarray:
+def tilt_rotation(about_x: float, about_y: float) -> np.ndarray:
     """R_y(about_y) @ R_x(about_x): positive about_y lowers +x, positive about_x lowers -y."""
     cx, sx = np.cos(about_x), np.sin(about_x)
     cy, sy = np.cos(about_y), np.sin(about_y)

@@ -6,7 +6,7 @@ import pytest
 
 import roto
 from roto.robots import ROBOTS, get_robot
-from roto.robots.mjspec_tools import palm_frame
+from roto.robots.mjspec_tools import palm_frame, tilt_rotation
 from roto.sim.scene import build_scene
 from roto.tasks.baoding import calibrate_targets
 
@@ -34,7 +34,6 @@ def test_sizes_follow_the_spec_table(name):
 
 @pytest.mark.parametrize("name", sorted(ROBOTS))
 def test_palm_frame_is_the_task_frame_up_to_the_hand_tilt(name):
-    from roto.robots.mjspec_tools import _tilt_rotation
 
     robot = get_robot(name)
     model, _ = build_scene(robot, ())
@@ -42,7 +41,7 @@ def test_palm_frame_is_the_task_frame_up_to_the_hand_tilt(name):
     mujoco.mj_kinematics(model, data)
     centre, rot = palm_frame(model, data, robot)
     np.testing.assert_allclose(centre, 0.0, atol=1e-6)
-    np.testing.assert_allclose(rot.T, _tilt_rotation(*robot.palm_tilt), atol=1e-6)
+    np.testing.assert_allclose(rot.T, tilt_rotation(*robot.palm_tilt), atol=1e-6)
 
 
 @pytest.mark.parametrize("name", sorted(ROBOTS))
