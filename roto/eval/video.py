@@ -46,7 +46,9 @@ class TactileFrameRenderer:
 
     def render(self) -> np.ndarray:
         """(height, width, 3) uint8 of world 0, touching links coloured (same threshold as the env)."""
-        mujoco.mj_setState(self.model, self.data, self.env.backend.state[0], mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        mujoco.mj_setState(
+            self.model, self.data, self.env.backend.physics_state()[0], mujoco.mjtState.mjSTATE_FULLPHYSICS
+        )
         mujoco.mj_forward(self.model, self.data)
         force = self.data.sensordata[self.env.layout.tactile_sensor + 1]
         self.model.geom_rgba[:] = self._base_rgba
@@ -82,7 +84,7 @@ def record_video(
         raise ValueError(f"video length must be >= 1 step, got {steps}")
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    env = RotoEnv(settings.env_config(num_envs=1, seed=seed))
+    env = RotoEnv(settings.cpu_env_config(num_envs=1, seed=seed))
     renderer = TactileFrameRenderer(env, width, height)
     obs_dict, _ = env.reset(seed=seed)
     frames = 0

@@ -63,7 +63,7 @@ class MujocoCpuBackend:
 
     def step(self, ctrl: torch.Tensor) -> SimState:
         """Hold ``ctrl`` (B, nu) for ``substeps`` physics steps on every world, in C threads."""
-        self._ctrl[:] = ctrl.detach().to(torch.float64).numpy()[:, None, :]
+        self._ctrl[:] = ctrl.detach().cpu().to(torch.float64).numpy()[:, None, :]
         self._pool.rollout(
             self._models,
             self._datas,
@@ -96,10 +96,10 @@ class MujocoCpuBackend:
         Returns their sensordata (n, nsensordata) evaluated at the new state under ``ctrl`` (n, nu)
         (one throw-away physics step computes it; its resulting state is discarded).
         """
-        ids = world_ids.numpy()
+        ids = world_ids.cpu().numpy()
         self.state[ids, 0] = 0.0
-        self.state[ids, self._qpos0 : self._qpos0 + self.model.nq] = qpos.to(torch.float64).numpy()
-        self.state[ids, self._qvel0 : self._qvel0 + self.model.nv] = qvel.to(torch.float64).numpy()
+        self.state[ids, self._qpos0 : self._qpos0 + self.model.nq] = qpos.cpu().to(torch.float64).numpy()
+        self.state[ids, self._qvel0 : self._qvel0 + self.model.nv] = qvel.cpu().to(torch.float64).numpy()
         n = len(ids)
         if n == 0:
             return torch.zeros((0, self.model.nsensordata), dtype=torch.float64)
@@ -108,7 +108,7 @@ class MujocoCpuBackend:
             self._models[:n],
             self._datas,
             np.ascontiguousarray(self.state[ids]),
-            np.ascontiguousarray(ctrl.to(torch.float64).numpy()[:, None, :]),
+            np.ascontiguousarray(ctrl.cpu().to(torch.float64).numpy()[:, None, :]),
             control_spec=_CTRL,
             skip_checks=True,
             nstep=1,
@@ -117,6 +117,20 @@ class MujocoCpuBackend:
             chunk_size=max(1, n // (self.threads * 10)),
         )
         return torch.from_numpy(sensors[:, 0])
+
+    def physics_state(self) -> np.ndarray:
+        """(B, nstate) float64 copy of every world's ``mjSTATE_FULLPHYSICS`` state."""
+        return self.state.copy()
+
+    def load_physics_state(self, state: np.ndarray) -> None:
+        """Overwrite every world from a (B, nstate) ``mjSTATE_FULLPHYSICS`` array."""
+        state = np.asarray(state)
+        if state.shape != self.state.shape:
+            raise ValueError(f"physics state has shape {state.shape}; this backend holds {self.state.shape}")
+        self.state[:] = state
+
+    def check_overflow(self) -> None:
+        """Nothing to check: MuJoCo C grows its contact and constraint buffers as needed."""
 
     def close(self) -> None:
         """Stop the thread pool."""
