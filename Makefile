@@ -2,6 +2,7 @@
 PYTHON ?= python3
 VENV := .venv
 STAMP := $(VENV)/.installed
+TEST_STAMP := $(VENV)/.installed-gpu-extra
 
 .PHONY: train test lint bench clean
 
@@ -12,13 +13,19 @@ $(STAMP): pyproject.toml
 	$(VENV)/bin/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
+# the tests also cover the Warp backend on Warp's CPU device, so they need the gpu extra
+$(TEST_STAMP): $(STAMP)
+	$(VENV)/bin/python -m pip install --quiet -e '.[dev,gpu]'
+	touch $(TEST_STAMP)
+
 # The quick start: a blind Shadow Bounce agent on the CPU (about 15 minutes on 2 cores).
 train: $(STAMP)
 	$(VENV)/bin/roto train --task bounce --robot shadow --obs blind --num_envs 128 --threads 2 \
 		--torch_threads 2 --steps 2500000 --agent_cfg roto/configs/bounce_cpu_quickstart.yaml
 
-test: $(STAMP)
-	$(VENV)/bin/python -m pytest -q
+# ROTO_REQUIRE_WARP: a missing MuJoCo Warp fails the Warp tests instead of skipping them
+test: $(TEST_STAMP)
+	ROTO_REQUIRE_WARP=1 $(VENV)/bin/python -m pytest -q
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check . && $(VENV)/bin/ruff format --check .

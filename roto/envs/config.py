@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import dataclass
 
 from roto.envs.observations import OBS_MODES
-
-BACKENDS = ("cpu",)
-"""Physics backends available in this build."""
+from roto.sim.backend import BACKENDS
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -19,8 +18,9 @@ class EnvConfig:
         robot: robot name (``shadow``).
         num_envs: number of parallel worlds B (>= 1).
         obs_mode: ``blind`` (proprio + tactile), ``state`` (+ privileged), ``proprio`` (no touch).
-        backend: physics backend (``cpu``: MuJoCo C threads).
-        device: torch device of all tensors the env returns.
+        backend: physics backend (``cpu``: MuJoCo C threads; ``warp``: MuJoCo Warp, see docs/backends.md).
+        device: torch device of all tensors the env returns, and where ``warp`` simulates
+            (``cpu`` or ``cuda[:k]``; the ``cpu`` backend needs ``cpu``).
         seed: seed of the reset noise.
         threads: C threads stepping the worlds (CPU backend).
         frame_stack: frames k stacked per observation group.
@@ -29,6 +29,9 @@ class EnvConfig:
         action_smoothing: alpha of the exponential smoothing of joint targets (1 = none).
         tactile_threshold: normal force (N) above which a link counts as touched.
         reset_joint_noise: half-width (rad) of the uniform noise added to the default pose at reset.
+        nconmax: contacts per world the ``warp`` backend allocates (None: roto's measured figure for
+            this robot and task, ``roto.envs.capacity``).
+        njmax: constraint rows per world for ``warp`` (None: as for ``nconmax``).
     """
 
     task: str
@@ -45,6 +48,8 @@ class EnvConfig:
     action_smoothing: float = 1.0
     tactile_threshold: float = 0.01
     reset_joint_noise: float = 0.2
+    nconmax: int | None = None
+    njmax: int | None = None
 
     def __post_init__(self) -> None:
         """Reject impossible values with a message naming the value and the valid choices."""
@@ -67,5 +72,30 @@ class EnvConfig:
             raise ValueError(f"substeps and episode_steps must be >= 1, got {self.substeps}, {self.episode_steps}")
         if not 0.0 < self.action_smoothing <= 1.0:
             raise ValueError(f"action_smoothing must be in (0, 1], got {self.action_smoothing!r}")
-        if self.device != "cpu" and not str(self.device).startswith("cpu"):
-            raise ValueError(f"device {self.device!r} is not available with backend {self.backend!r}; valid: ['cpu']")
+        for name in ("nconmax", "njmax"):
+            value = getattr(self, name)
+            if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
+                raise ValueError(f"{name} must be an integer >= 1 or None, got {value!r}")
+        self._check_device()
+
+    def _check_device(self) -> None:
+        device = str(self.device)
+        if self.backend == "cpu":
+            if device != "cpu":
+                raise ValueError(
+                    f"device {device!r} is not available with backend 'cpu'; valid: ['cpu'] "
+                    "(backend='warp' simulates on a CUDA device)"
+                )
+            return
+        if importlib.util.find_spec("mujoco_warp") is None:
+            raise ValueError("backend 'warp' needs MuJoCo Warp, which is not installed: pip install -e '.[gpu]'")
+        if device != "cpu" and not (device == "cuda" or device.startswith("cuda:")):
+            raise ValueError(f"device {device!r} is not valid with backend 'warp'; valid: ['cpu', 'cuda', 'cuda:<k>']")
+        if device.startswith("cuda"):
+            import torch
+
+            if not torch.cuda.is_available():
+                raise ValueError(
+                    f"device {device!r} was asked for, but this machine has no CUDA GPU that torch can use; "
+                    "use device='cpu' (Warp's CPU device, slow) or backend='cpu'"
+                )

@@ -15,15 +15,24 @@ import gymnasium as gym
 import numpy as np
 import torch
 
+from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target
 from roto.envs.observations import OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
-from roto.sim.mujoco_cpu import MujocoCpuBackend
+from roto.sim.backend import make_backend
 from roto.sim.scene import SceneLayout, build_scene
 from roto.tasks import get_task
 from roto.tasks.base import TaskInputs, uniform
+
+
+def resolve_device(device: str | torch.device) -> torch.device:
+    """``device`` with its index made explicit (``cuda`` -> ``cuda:<current>``), as tensors report it."""
+    device = torch.device(device)
+    if device.type == "cuda" and device.index is None:
+        return torch.device("cuda", torch.cuda.current_device())
+    return device
 
 
 @dataclass
@@ -44,11 +53,21 @@ class RotoEnv:
         self.task = get_task(config.task)
         self.robot: RobotSpec = get_robot(config.robot)
         self.num_envs = config.num_envs
-        self.device = torch.device(config.device)
+        self.device = resolve_device(config.device)
         self.groups = OBS_MODES[config.obs_mode]
         self.balls = self.task.balls(self.robot)
         self.model, self.layout = build_scene(self.robot, self.balls)
-        self.backend = MujocoCpuBackend(self.model, config.num_envs, substeps=config.substeps, threads=config.threads)
+        nconmax, njmax = warp_capacity(config.robot, config.task)
+        self.backend = make_backend(
+            config.backend,
+            self.model,
+            config.num_envs,
+            substeps=config.substeps,
+            threads=config.threads,
+            device=config.device,
+            nconmax=config.nconmax or nconmax,
+            njmax=config.njmax or njmax,
+        )
         self._generator = torch.Generator(device=self.device)
         self._generator.manual_seed(config.seed)
         self._idx = _Indices.from_layout(self.layout, self.robot, self.model, self.device)
@@ -102,9 +121,10 @@ class RotoEnv:
         self._last_action = action.to(torch.float32, copy=True)  # never alias the caller's tensor
 
         sim = self.backend.step(self._target)
-        qpos = sim.qpos.to(self.device)
-        qvel = sim.qvel.to(self.device)
-        sensors = sim.sensordata.to(self.device)
+        f64 = torch.float64
+        qpos = sim.qpos.to(self.device, f64)
+        qvel = sim.qvel.to(self.device, f64)
+        sensors = sim.sensordata.to(self.device, f64)
         diverged = sim.diverged.to(self.device)
 
         inputs = self._task_inputs(qpos, qvel, sensors)
@@ -148,7 +168,7 @@ class RotoEnv:
         (what exact training resume relies on).
         """
         return {
-            "physics": torch.from_numpy(self.backend.state.copy()),
+            "physics": torch.from_numpy(self.backend.physics_state()),
             "task": {f.name: getattr(self.task_state, f.name).clone() for f in dataclasses.fields(self.task_state)},
             "frames": self._stack.state_dict(),
             "episode_length": self._episode.length.clone(),
@@ -163,13 +183,7 @@ class RotoEnv:
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore what ``state_dict`` returned (same config: task, robot, num_envs)."""
-        physics = state["physics"].numpy()
-        if physics.shape != self.backend.state.shape:
-            raise ValueError(
-                f"env state holds {physics.shape[0]} worlds of size {physics.shape[1]}, "
-                f"this env has {self.backend.state.shape}"
-            )
-        self.backend.state[:] = physics
+        self.backend.load_physics_state(state["physics"].cpu().numpy())
         for name, value in state["task"].items():
             setattr(self.task_state, name, value.clone().to(self.device))
         self._stack.load_state_dict({name: value.to(self.device) for name, value in state["frames"].items()})
@@ -178,7 +192,7 @@ class RotoEnv:
         self._term_sums = {name: value.clone().to(self.device) for name, value in state["term_sums"].items()}
         self._target = state["target"].clone().to(self.device)
         self._last_action = state["last_action"].clone().to(self.device)
-        self._generator.set_state(state["generator"])
+        self._generator.set_state(state["generator"].cpu())
         self.nonfinite_resets = int(state["nonfinite_resets"])
         self._needs_reset = bool(state["needs_reset"])
 
@@ -264,7 +278,7 @@ class RotoEnv:
         qpos[:, idx.ball_quat] = idx.identity_quat
         qvel = torch.zeros(n, self.model.nv, dtype=torch.float64, device=self.device)
         target = qpos[:, idx.act_qpos]
-        sensors = self.backend.set_state(env_ids.cpu(), qpos.cpu(), qvel.cpu(), target.cpu()).to(self.device)
+        sensors = self.backend.set_state(env_ids, qpos, qvel, target).to(self.device, torch.float64)
 
         self._target[env_ids] = target
         self._last_action[env_ids] = 0.0
