@@ -27,7 +27,7 @@ def evaluate(
     per_episode: dict[str, list[float]] = {}
     for batch in range(math.ceil(episodes / MAX_PARALLEL_ENVS)):
         n = min(MAX_PARALLEL_ENVS, episodes - batch * MAX_PARALLEL_ENVS)
-        env = RotoEnv(settings.env_config(num_envs=n, seed=seed + batch))
+        env = RotoEnv(settings.cpu_env_config(num_envs=n, seed=seed + batch))
         obs, _ = env.reset(seed=seed + batch)
         result = first_episodes(env, lambda o: model.act_deterministic(flatten_obs(o)), obs)
         env.close()

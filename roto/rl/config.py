@@ -58,6 +58,9 @@ class RunConfig:
     """Evaluation, logging and checkpoint cadence of a training run."""
 
     num_eval_envs: int = 8
+    """Evaluation envs when the training envs simulate on the CPU (either backend)."""
+    num_eval_envs_gpu: int = 100
+    """Evaluation envs when they simulate on a CUDA device (the paper's 100)."""
     checkpoint_every: int = 50
     """Write ``latest.pt`` (and keep ``agent_<update>.pt``) every this many updates."""
 
@@ -75,6 +78,7 @@ class AgentConfig:
         p = self.ppo
         positive = {"ppo.rollouts": p.rollouts, "ppo.epochs": p.epochs, "ppo.minibatches": p.minibatches}
         positive["run.num_eval_envs"] = self.run.num_eval_envs
+        positive["run.num_eval_envs_gpu"] = self.run.num_eval_envs_gpu
         positive["run.checkpoint_every"] = self.run.checkpoint_every
         for name, value in positive.items():
             if value < 1:

@@ -35,10 +35,14 @@ class TrainSettings:
     env: EnvConfig
     total_steps: int = 1_000_000
 
-    def env_config(self, num_envs: int | None = None, seed: int | None = None) -> EnvConfig:
-        """The training envs' config, or that of evaluation envs with another num_envs / seed."""
-        changes = {name: value for name, value in (("num_envs", num_envs), ("seed", seed)) if value is not None}
+    def env_config(self, num_envs: int | None = None, seed: int | None = None, **changes: Any) -> EnvConfig:
+        """The training envs' config, or that of other envs (another num_envs / seed / backend ...)."""
+        changes.update({name: value for name, value in (("num_envs", num_envs), ("seed", seed)) if value is not None})
         return dataclasses.replace(self.env, **changes)
+
+    def cpu_env_config(self, num_envs: int | None = None, seed: int | None = None) -> EnvConfig:
+        """As ``env_config``, on the CPU backend: evaluation and videos of any run, GPU-trained too."""
+        return self.env_config(num_envs, seed, backend="cpu", device="cpu")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain nested dict (for config.yaml and checkpoints)."""
@@ -137,16 +141,20 @@ class Trainer:
         self.run_dir = pathlib.Path(run_dir)
         (self.run_dir / CHECKPOINT_DIR).mkdir(parents=True, exist_ok=True)
         self.env = env_factory(settings.env_config())
+        self.num_eval_envs = agent.run.num_eval_envs_gpu if self.env.device.type == "cuda" else agent.run.num_eval_envs
         self.eval_env = env_factory(
-            settings.env_config(num_envs=agent.run.num_eval_envs, seed=settings.env.seed + EVAL_SEED_OFFSET)
+            settings.env_config(num_envs=self.num_eval_envs, seed=settings.env.seed + EVAL_SEED_OFFSET)
         )
+        self.device = self.env.device  # the policy learns where the envs simulate
         torch.manual_seed(settings.env.seed)
-        self.model = build_model(self.env, agent)
+        self.model = build_model(self.env, agent).to(self.device)
         self.ppo = PPO(self.model, agent.ppo)
-        self.generator = torch.Generator().manual_seed(settings.env.seed)
+        self.generator = torch.Generator(device=self.device).manual_seed(settings.env.seed)
         obs_dim = self.model.encoder[0].in_features
-        self.buffer = RolloutBuffer(agent.ppo.rollouts, settings.env.num_envs, obs_dim, self.env.num_actions, "cpu")
-        self.eval_rounds = EvalRounds(agent.run.num_eval_envs, self.env.task.metric_names)
+        self.buffer = RolloutBuffer(
+            agent.ppo.rollouts, settings.env.num_envs, obs_dim, self.env.num_actions, self.device
+        )
+        self.eval_rounds = EvalRounds(self.num_eval_envs, self.env.task.metric_names)
         self.update = 0
         self.env_steps = 0
         self.best_eval_return = -math.inf
@@ -186,7 +194,7 @@ class Trainer:
             t0 = time.perf_counter()
             mean, log_std, value_head = self.model(self.obs)
             std = log_std.exp().expand_as(mean)
-            action = mean + std * torch.randn(mean.shape, generator=self.generator)
+            action = mean + std * torch.randn(mean.shape, generator=self.generator, device=self.device)
             log_prob = torch.distributions.Normal(mean, std).log_prob(action).sum(-1)
             value = self.ppo.values(value_head)
             eval_action = self.model.act_deterministic(self.eval_obs)
@@ -312,8 +320,8 @@ class Trainer:
         """Restore a checkpoint written by ``save``."""
         self.model.load_state_dict(state["model"])
         self.ppo.load_state_dict(state["ppo"])
-        self.generator.set_state(state["generator"])
-        torch.set_rng_state(state["torch_rng"])
+        self.generator.set_state(state["generator"].cpu())  # RNG states are CPU byte tensors
+        torch.set_rng_state(state["torch_rng"].cpu())
         self.env.load_state_dict(state["env"])
         self.eval_env.load_state_dict(state["eval_env"])
         self.obs, self.eval_obs = state["obs"], state["eval_obs"]
@@ -340,7 +348,7 @@ class Trainer:
         if total_steps is not None:
             settings = dataclasses.replace(settings, total_steps=total_steps)
         trainer = cls(settings, agent, run_dir, tensorboard=tensorboard, env_factory=env_factory)
-        trainer.load_state_dict(torch.load(checkpoint, weights_only=False))
+        trainer.load_state_dict(torch.load(checkpoint, weights_only=False, map_location=trainer.device))
         return trainer
 
 
@@ -352,7 +360,7 @@ def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSetti
     state = torch.load(path, weights_only=False, map_location="cpu")
     settings = TrainSettings.from_dict(state["train"])
     agent = from_dict(AgentConfig, state["agent"]).validate()
-    env = RotoEnv(settings.env_config(num_envs=1))
+    env = RotoEnv(settings.cpu_env_config(num_envs=1))
     model = build_model(env, agent)
     env.close()
     model.load_state_dict(state["model"])

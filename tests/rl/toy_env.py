@@ -27,6 +27,7 @@ class ToyEnv:
     def __init__(self, config: EnvConfig) -> None:
         self.config = config
         self.num_envs = config.num_envs
+        self.device = torch.device("cpu")
         self.num_actions = 2
         self.frame_sizes = {"proprio": 2}
         self.task = _ToyTask()
