@@ -1,7 +1,12 @@
-"""Throughput benchmark: env steps/s against plain single-thread ``mj_step`` of the same model.
+"""Throughput benchmark: env steps/s against plain physics stepping of the same model.
 
-``efficiency = env_steps_per_s · substeps / (threads · raw_physics_steps_per_s)``: 1.0 means the
-env costs no more than its physics on each thread it uses.
+CPU backend: ``efficiency = env_steps_per_s · substeps / (threads · raw_physics_steps_per_s)``,
+where the raw figure is single-thread ``mj_step``; 1.0 means the env costs no more than its
+physics on each thread it uses.
+
+Warp backend: ``efficiency = env_steps_per_s · substeps / raw_physics_steps_per_s``, where the raw
+figure is plain ``mujoco_warp.step`` on all B worlds of the same model and device (graph-captured
+on a GPU, like the env's step); 1.0 means the env costs no more than its batched physics.
 """
 
 from __future__ import annotations
@@ -46,34 +51,39 @@ def run_bench(
     warmup: int = 20,
     obs_mode: str = "blind",
     seed: int = 0,
+    backend: str = "cpu",
+    device: str = "cpu",
 ) -> dict[str, Any]:
     """Measure env and raw physics throughput in one run; returns the JSON-able result."""
     torch.set_num_threads(1)
-    env = make(task, robot=robot, num_envs=num_envs, obs_mode=obs_mode, seed=seed, threads=threads)
+    env = make(
+        task,
+        robot=robot,
+        num_envs=num_envs,
+        obs_mode=obs_mode,
+        seed=seed,
+        threads=threads,
+        backend=backend,
+        device=device,
+    )
     generator = torch.Generator().manual_seed(seed)
-    actions = _random_actions(generator, num_envs, env.num_actions, warmup + steps)
+    actions = _random_actions(generator, num_envs, env.num_actions, warmup + steps).to(env.device)
     env.reset()
     for t in range(warmup):
         env.step(actions[t])
-    wall = 0.0
-    raw_rates = []
-    sample_every = max(1, steps // 4)
-    for t in range(warmup, warmup + steps):
-        if (t - warmup) % sample_every == 0:
-            # the raw-physics reference runs on the env's own current states and targets
-            raw_rates.append(
-                raw_physics_steps_per_s(env, env.backend.state.copy(), env._target.numpy(), env.config.substeps)
-            )
-        start = time.perf_counter()
-        env.step(actions[t])
-        wall += time.perf_counter() - start
+    if backend == "cpu":
+        env_rate, raw = _time_cpu(env, actions[warmup:])
+        efficiency = env_rate * env.config.substeps / (threads * raw)
+    else:
+        env_rate, raw = _time_warp(env, actions[warmup:])
+        efficiency = env_rate * env.config.substeps / raw
+    env.backend.check_overflow()
     env.close()
-    env_rate = num_envs * steps / wall
-    raw = float(np.mean(raw_rates))
     return {
         "task": task,
         "robot": robot,
-        "backend": "cpu",
+        "backend": backend,
+        "device": str(env.device),
         "obs_mode": obs_mode,
         "num_envs": num_envs,
         "threads": threads,
@@ -81,7 +91,48 @@ def run_bench(
         "steps": steps,
         "env_steps_per_s": round(env_rate, 1),
         "raw_physics_steps_per_s": round(raw, 1),
-        "efficiency": round(env_rate * env.config.substeps / (threads * raw), 3),
-        "machine": f"{platform.processor() or platform.machine()}, {torch.get_num_threads()} torch thread(s)",
+        "efficiency": round(efficiency, 3),
+        "machine": _machine(env.device),
         "mujoco": mujoco.__version__,
     }
+
+
+def _time_cpu(env: Any, actions: torch.Tensor) -> tuple[float, float]:
+    """(env steps/s, single-thread raw physics steps/s) over ``actions`` (steps, B, n)."""
+    wall = 0.0
+    raw_rates = []
+    steps = len(actions)
+    sample_every = max(1, steps // 4)
+    for t in range(steps):
+        if t % sample_every == 0:
+            # the raw-physics reference runs on the env's own current states and targets
+            raw_rates.append(
+                raw_physics_steps_per_s(env, env.backend.physics_state(), env._target.numpy(), env.config.substeps)
+            )
+        start = time.perf_counter()
+        env.step(actions[t])
+        wall += time.perf_counter() - start
+    return env.num_envs * steps / wall, float(np.mean(raw_rates))
+
+
+def _synchronize(device: torch.device) -> None:
+    if device.type == "cuda":
+        torch.cuda.synchronize(device)
+
+
+def _time_warp(env: Any, actions: torch.Tensor) -> tuple[float, float]:
+    """(env steps/s, bare ``mujoco_warp.step`` physics steps/s on all B worlds) over ``actions``."""
+    _synchronize(env.device)
+    start = time.perf_counter()
+    for action in actions:
+        env.step(action)
+    _synchronize(env.device)
+    env_rate = env.num_envs * len(actions) / (time.perf_counter() - start)
+    return env_rate, env.backend.bare_physics_steps_per_s(len(actions))
+
+
+def _machine(device: torch.device) -> str:
+    cpu = f"{platform.processor() or platform.machine()}, {torch.get_num_threads()} torch thread(s)"
+    if device.type == "cuda":
+        return f"{torch.cuda.get_device_name(device)}; {cpu}"
+    return cpu

@@ -14,6 +14,8 @@ def _add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
     parser.add_argument("--num_envs", "--num-envs", dest="num_envs", type=int, default=num_envs)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--threads", type=int, default=1, help="C threads stepping the worlds (CPU backend)")
+    parser.add_argument("--backend", default="cpu", help="physics backend: cpu (default) or warp (MuJoCo Warp)")
+    parser.add_argument("--device", default="cpu", help="cpu (default), or cuda[:k] with --backend warp")
     parser.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; no effect")
 
 
@@ -42,6 +44,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         steps=args.steps,
         obs_mode=args.obs_mode,
         seed=args.seed,
+        backend=args.backend,
+        device=args.device,
     )
     if args.json:
         print(json.dumps(result))
@@ -54,7 +58,15 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 def _cmd_demo(args: argparse.Namespace) -> int:
     from roto.scripted import run_scripted_bounce
 
-    stats = run_scripted_bounce(num_envs=args.num_envs, seed=args.seed, episodes=args.episodes, progress=True)
+    stats = run_scripted_bounce(
+        robot=args.robot,
+        num_envs=args.num_envs,
+        seed=args.seed,
+        episodes=args.episodes,
+        progress=True,
+        backend=args.backend,
+        device=args.device,
+    )
     print(json.dumps(stats))
     return 0
 
@@ -80,6 +92,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
             num_envs=args.num_envs,
             seed=args.seed,
             backend=args.backend,
+            device=args.device,
             threads=args.threads,
         )
         settings = TrainSettings(env=env, total_steps=args.steps if args.steps is not None else 1_000_000)
@@ -147,7 +160,6 @@ def build_parser() -> argparse.ArgumentParser:
     p_train.add_argument(
         "--agent_cfg", "--agent-cfg", dest="agent_cfg", default=None, help="agent YAML (default: the task's)"
     )
-    p_train.add_argument("--backend", default="cpu", help="simulation backend (default: cpu)")
     p_train.add_argument(
         "--run_dir", "--run-dir", dest="run_dir", default=None, help="default: runs/<task>_<robot>_<obs>/<time>"
     )
@@ -183,7 +195,7 @@ def build_parser() -> argparse.ArgumentParser:
     p_list = sub.add_parser("list", help="every (task, robot) pair with its observation and action sizes")
     p_list.set_defaults(func=_cmd_list)
 
-    p_bench = sub.add_parser("bench", help="env throughput vs plain single-thread mj_step of the same model")
+    p_bench = sub.add_parser("bench", help="env throughput vs plain physics stepping of the same model")
     _add_env_args(p_bench, num_envs=256)
     p_bench.add_argument("--steps", type=int, default=200, help="timed control steps (default: 200)")
     p_bench.add_argument("--obs_mode", "--obs-mode", dest="obs_mode", default="blind")

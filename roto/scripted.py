@@ -201,12 +201,14 @@ def run_scripted_bounce(
     episodes: int = 1,
     progress: bool = False,
     script: BounceScript | None = None,
+    backend: str = "cpu",
+    device: str = "cpu",
 ) -> dict[str, float]:
     """Run the scripted policy until each env has finished ``episodes`` episodes; bounce statistics.
 
     Each env contributes exactly its first ``episodes`` episodes, so short episodes are not favoured.
     """
-    env = make("bounce", robot=robot, num_envs=num_envs, obs_mode="state", seed=seed)
+    env = make("bounce", robot=robot, num_envs=num_envs, obs_mode="state", seed=seed, backend=backend, device=device)
     policy = ScriptedBounce(env, script)
     obs, _ = env.reset(seed=seed)
     result = first_episodes(env, policy, obs, episodes, on_done=policy.reset, progress=progress)
