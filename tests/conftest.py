@@ -1,3 +1,6 @@
+import importlib.util
+import os
+
 import pytest
 import torch
 
@@ -12,3 +15,11 @@ def _one_torch_thread():
 def make_env(task: str = "bounce", **kwargs):
     kwargs.setdefault("num_envs", 2)
     return roto.make(task, **kwargs)
+
+
+def require_warp() -> None:
+    """Skip without MuJoCo Warp, unless ROTO_REQUIRE_WARP is set (``make test``), then fail."""
+    if importlib.util.find_spec("mujoco_warp") is None:
+        if os.environ.get("ROTO_REQUIRE_WARP"):
+            pytest.fail("MuJoCo Warp is not installed but ROTO_REQUIRE_WARP is set: pip install -e '.[gpu]'")
+        pytest.skip("MuJoCo Warp is not installed (pip install -e '.[gpu]')")
