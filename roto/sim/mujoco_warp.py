@@ -22,6 +22,7 @@ synchronisation).
 
 from __future__ import annotations
 
+import functools
 import os
 import pathlib
 import time
@@ -74,7 +75,11 @@ def _import_warp():
     return wp, mjw
 
 
+@functools.cache
 def _define_kernels(wp):
+    """roto's own kernel, defined once per process: redefining it for every backend would mark its
+    Warp module modified and reload it, under the feet of graphs already captured with it."""
+
     @wp.kernel
     def record_substep(
         sensordata: wp.array2d(dtype=wp.float32),
