@@ -17,7 +17,7 @@ import torch
 
 from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
-from roto.envs.control import action_to_target, smooth_target
+from roto.envs.control import action_to_target, smooth_target, target_to_action
 from roto.envs.observations import OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
@@ -81,7 +81,7 @@ class RotoEnv:
         self._target = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
         self._last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
-        self.nonfinite_resets = 0
+        self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
         self._needs_reset = True
         self.frame_sizes = self._frame_sizes()
         self.observation_space = gym.spaces.Dict(
@@ -146,13 +146,13 @@ class RotoEnv:
 
         done = terminated | truncated
         info: dict[str, Any] = {"reward_terms": result.reward_terms, "nonfinite": diverged}
-        if bool(done.any()):
+        done_ids = torch.nonzero(done).flatten()  # the step's one read-back after physics (reset count)
+        if len(done_ids):
             info["final_obs"] = obs
             info["_final_obs"] = done
             info["episode"] = self._episode_info(truncated)
             info["_episode"] = done
-            self.nonfinite_resets += int(diverged.sum())
-            done_ids = torch.nonzero(done).flatten()
+            self._nonfinite_resets += diverged.sum()  # stays on the device until someone reads it
             self._stack.reset(self._reset_worlds(done_ids), done_ids)
             obs = self._stack.observation()
         return obs, reward.to(torch.float32), terminated, truncated, info
@@ -193,8 +193,18 @@ class RotoEnv:
         self._target = state["target"].clone().to(self.device)
         self._last_action = state["last_action"].clone().to(self.device)
         self._generator.set_state(state["generator"].cpu())
-        self.nonfinite_resets = int(state["nonfinite_resets"])
+        self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
+
+    @property
+    def nonfinite_resets(self) -> int:
+        """Worlds reset so far because their physics went non-finite (reading it waits for the device)."""
+        return int(self._nonfinite_resets)
+
+    def hold_action(self) -> torch.Tensor:
+        """(1, num_actions) float32 action whose joint targets are the default (cupped) pose."""
+        idx = self._idx
+        return target_to_action(idx.default_qpos[:, idx.act_qpos], idx.ctrl_lo, idx.ctrl_hi).to(torch.float32)
 
     @property
     def unwrapped(self) -> RotoEnv:

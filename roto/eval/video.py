@@ -11,7 +11,6 @@ import mujoco
 import numpy as np
 import torch
 
-from roto.envs.control import target_to_action
 from roto.envs.roto_env import RotoEnv
 from roto.rl.networks import ActorCritic
 from roto.rl.runner import TrainSettings, flatten_obs
@@ -126,8 +125,7 @@ def render_scene(
     path.parent.mkdir(parents=True, exist_ok=True)
     env = RotoEnv(EnvConfig(task=task, robot=robot, num_envs=1, seed=seed, reset_joint_noise=0.0))
     env.reset(seed=seed)
-    idx = env._idx
-    hold = target_to_action(idx.default_qpos[:, idx.act_qpos], idx.ctrl_lo, idx.ctrl_hi)
+    hold = env.hold_action()
     for _ in range(settle_steps):
         env.step(hold)
     renderer = TactileFrameRenderer(env, width, height)

@@ -204,12 +204,8 @@ class MujocoWarpBackend:
         self._steps += 1
         if self.overflow_check_every and self._steps % self.overflow_check_every == 0:
             self.check_overflow()
-        diverged = ~(
-            torch.isfinite(self._qpos).all(dim=1)
-            & torch.isfinite(self._qvel).all(dim=1)
-            & (self._qpos.abs() <= MAX_VALUE).all(dim=1)
-            & (self._qvel.abs() <= MAX_VALUE).all(dim=1)
-        )
+        # NaN and inf both fail "<= MAX_VALUE", so one comparison covers non-finite values too
+        diverged = ~((self._qpos.abs() <= MAX_VALUE).all(dim=1) & (self._qvel.abs() <= MAX_VALUE).all(dim=1))
         return SimState(qpos=self._qpos, qvel=self._qvel, sensordata=self._sensors, diverged=diverged)
 
     def set_state(
@@ -229,7 +225,7 @@ class MujocoWarpBackend:
         self._act[ids] = 0.0
         self._ctrl[ids] = ctrl.to(self.device, torch.float32)
         self._run(self._forward_graph, self._forward_sequence)
-        return self._sensordata[ids].clone()
+        return self._sensordata[ids]  # indexing by a tensor copies
 
     def physics_state(self) -> np.ndarray:
         """(B, nstate) float64 host copy of every world's ``mjSTATE_FULLPHYSICS`` state."""

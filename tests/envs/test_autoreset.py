@@ -1,15 +1,13 @@
 import numpy as np
 import torch
 
-from roto.envs.control import target_to_action
 from tests.conftest import make_env
 
 
 def test_time_out_truncates_at_episode_steps_and_resets_in_the_same_step():
     env = make_env("baoding", num_envs=2, episode_steps=30)
     env.reset()
-    idx = env._idx
-    hold = target_to_action(idx.default_qpos[0, idx.act_qpos], idx.ctrl_lo, idx.ctrl_hi)
+    hold = env.hold_action()[0]
     for step in range(1, 31):
         _, _, terminated, truncated, info = env.step(hold.expand(2, -1))
         assert not terminated.any()

@@ -3,7 +3,6 @@ import numpy as np
 import pytest
 import torch
 
-from roto.envs.control import target_to_action
 from roto.envs.observations import tactile_bits
 from roto.robots import ROBOTS, get_robot
 from roto.sim.scene import BallSpec, build_scene
@@ -34,8 +33,7 @@ def test_bits_clear_within_one_step_after_the_ball_leaves(name):
     obs, _ = env.reset()
     for _ in range(30):
         obs, *_ = env.step(torch.zeros(1, env.num_actions))
-    idx = env._idx
-    hold = target_to_action(idx.default_qpos[:, idx.act_qpos], idx.ctrl_lo, idx.ctrl_hi)
+    hold = env.hold_action()
     env.reset()
     for _ in range(30):
         obs, *_ = env.step(hold)

@@ -11,7 +11,6 @@ import pytest
 import torch
 
 import roto
-from roto.envs.control import target_to_action
 from roto.robots import ROBOTS, get_robot
 from roto.sim.backend import make_backend
 from roto.sim.scene import BallSpec, build_scene
@@ -29,8 +28,8 @@ BOX_FINGERS = {"orca"}
 """Hands whose finger collision shapes are boxes. When neighbouring fingers press together, MuJoCo
 Warp's box-box collider returns some contact points twice where MuJoCo C returns them once (same
 position, same depth; seen on ORCA's proximal links), so finger-finger forces differ and the
-trajectories part within a few steps. Their parity is checked on the held pose, where no finger
-presses on another (docs/backends.md)."""
+trajectories part within a few steps. Their parity is checked holding the default pose, where no
+finger presses on another (docs/backends.md)."""
 
 
 @pytest.fixture(autouse=True)
@@ -50,7 +49,7 @@ def physics(env) -> torch.Tensor:
 
 
 def assert_parity(task: str, robot: str, workload: str = "smooth") -> None:
-    """CPU and Warp envs from the same seed and actions: ``smooth`` sinusoids or ``hold`` (zero action)."""
+    """CPU and Warp envs from the same seed and actions: ``smooth`` sinusoids or ``hold`` (default pose)."""
     cpu = roto.make(task, robot=robot, num_envs=3, seed=0)
     warp = roto.make(task, robot=robot, num_envs=3, seed=0, backend="warp")
     obs_cpu, _ = cpu.reset()
@@ -61,7 +60,7 @@ def assert_parity(task: str, robot: str, workload: str = "smooth") -> None:
     worst = 0.0
     actions = smooth_actions(PARITY_STEPS, 3, cpu.num_actions)
     if workload == "hold":
-        actions = torch.zeros_like(actions)
+        actions = cpu.hold_action().expand_as(actions)
     for action in actions:
         obs_cpu, reward_cpu, term_cpu, trunc_cpu, _ = cpu.step(action)
         obs_warp, reward_warp, term_warp, trunc_warp, _ = warp.step(action)
@@ -112,7 +111,7 @@ def test_ball_on_palm_gives_identical_bits_on_both_backends(name):
 def test_held_baoding_balls_and_their_lift_read_the_same_on_both_backends(name):
     envs = [roto.make("baoding", robot=name, num_envs=1, backend=b) for b in ("cpu", "warp")]
     idx = envs[0]._idx
-    hold = target_to_action(idx.default_qpos[:, idx.act_qpos], idx.ctrl_lo, idx.ctrl_hi).to(torch.float32)
+    hold = envs[0].hold_action()
     tactile = []
     for env in envs:
         env.reset()
