@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import pathlib
@@ -52,6 +53,26 @@ class TrainSettings:
     def from_dict(cls, data: dict[str, Any]) -> TrainSettings:
         """Inverse of ``to_dict``."""
         return cls(env=EnvConfig(**data["env"]), total_steps=int(data["total_steps"]))
+
+
+@contextlib.contextmanager
+def single_torch_thread(device: torch.device) -> Any:
+    """Run the block with one torch CPU thread, then restore the previous count.
+
+    Rollouts on the CPU backend share the cores with MuJoCo's stepping threads; a second torch
+    (OpenMP) thread busy-waiting after the policy's small matrix products steals time from them
+    (measured: 0.52 s instead of 0.39 s of simulation per 4096 steps). The PPO update keeps the
+    configured count. No effect on CUDA devices.
+    """
+    if device.type != "cpu":
+        yield
+        return
+    previous = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(previous)
 
 
 def flatten_obs(obs: dict[str, torch.Tensor]) -> torch.Tensor:
@@ -240,7 +261,8 @@ class Trainer:
         try:
             while self.update < self.total_updates:
                 t_start = time.perf_counter()
-                stats, rounds = self._collect()
+                with single_torch_thread(self.device):
+                    stats, rounds = self._collect()
                 t_update = time.perf_counter()
                 last_values = self.ppo.values(self.model(self.obs)[2].detach())
                 self.ppo.finish_rollout(self.buffer, last_values)

@@ -1,7 +1,7 @@
 import pytest
 import torch
 
-from roto.rl.runner import EvalRounds, flatten_obs
+from roto.rl.runner import EvalRounds, flatten_obs, single_torch_thread
 
 
 def info(done, returns, lengths, bounces):
@@ -33,3 +33,19 @@ def test_flatten_obs_concatenates_groups_in_order():
     flat = flatten_obs(obs)
     assert flat.shape == (2, 7) and flat.dtype == torch.float32
     assert flat[:, :3].eq(1).all() and flat[:, 3:].eq(0).all()
+
+
+def test_rollouts_run_on_one_torch_thread_and_the_count_comes_back():
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        with single_torch_thread(torch.device("cpu")):
+            assert torch.get_num_threads() == 1
+        assert torch.get_num_threads() == 2
+        with pytest.raises(KeyError), single_torch_thread(torch.device("cpu")):
+            raise KeyError("inside the block")
+        assert torch.get_num_threads() == 2
+        with single_torch_thread(torch.device("meta")):  # not the CPU: left alone
+            assert torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)
