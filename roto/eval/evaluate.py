@@ -9,7 +9,7 @@ import torch
 from roto.envs.roto_env import RotoEnv
 from roto.eval.episodes import first_episodes
 from roto.rl.networks import ActorCritic
-from roto.rl.runner import TrainSettings, flatten_obs
+from roto.rl.runner import TrainSettings, flatten_obs, single_torch_thread
 
 MAX_PARALLEL_ENVS = 128
 
@@ -29,7 +29,8 @@ def evaluate(
         n = min(MAX_PARALLEL_ENVS, episodes - batch * MAX_PARALLEL_ENVS)
         env = RotoEnv(settings.cpu_env_config(num_envs=n, seed=seed + batch))
         obs, _ = env.reset(seed=seed + batch)
-        result = first_episodes(env, lambda o: model.act_deterministic(flatten_obs(o)), obs)
+        with single_torch_thread(env.device):
+            result = first_episodes(env, lambda o: model.act_deterministic(flatten_obs(o)), obs)
         env.close()
         for name, values in result.items():
             key = {"r": "return", "l": "length"}.get(name, name)
