@@ -164,7 +164,14 @@ def build_parser() -> argparse.ArgumentParser:
         "--run_dir", "--run-dir", dest="run_dir", default=None, help="default: runs/<task>_<robot>_<obs>/<time>"
     )
     p_train.add_argument("--resume", default=None, metavar="RUN_DIR", help="continue a run from its latest checkpoint")
-    p_train.add_argument("--torch_threads", "--torch-threads", dest="torch_threads", type=int, default=1)
+    p_train.add_argument(
+        "--torch_threads",
+        "--torch-threads",
+        dest="torch_threads",
+        type=int,
+        default=1,
+        help="torch CPU threads for the PPO update; rollouts always use one (default 1)",
+    )
     p_train.add_argument("--no_progress", "--no-progress", dest="no_progress", action="store_true")
     p_train.add_argument("overrides", nargs="*", metavar="section.key=value", help="agent config overrides")
     p_train.set_defaults(func=_cmd_train)
