@@ -1,9 +1,11 @@
-"""CPU backend: B MuJoCo worlds stepped in C threads by a persistent ``mujoco.rollout`` pool.
+"""CPU backend: B MuJoCo worlds stepped by ``mujoco.rollout`` in C, on ``threads`` threads.
 
 The full physics state of every world lives in one float64 array ``(B, nstate)``. A control step
-is a single ``rollout`` call over all B worlds (the GIL is released; no per-world Python), after
-which the last substep's state becomes the new state. Warm-start accelerations are zeroed at every
-call, as ``rollout`` does, which keeps results independent of how worlds are spread over threads.
+rolls all B worlds ``substeps`` steps, in chunks spread over the calling thread and persistent
+helper threads (``RolloutThreads``; the GIL is released inside ``rollout``, no per-world Python),
+after which the last substep's state becomes the new state. Warm-start accelerations are zeroed
+for every world, as ``rollout`` does, which keeps results independent of how worlds are spread
+over threads.
 """
 
 from __future__ import annotations
@@ -11,12 +13,11 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import torch
-from mujoco import rollout
 
 from roto.sim.backend import SimState
+from roto.sim.rollout_threads import RolloutThreads, default_chunk_size
 
 _FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
-_CTRL = mujoco.mjtState.mjSTATE_CTRL.value
 
 
 def state_offsets(model: mujoco.MjModel) -> tuple[int, int]:
@@ -27,7 +28,7 @@ def state_offsets(model: mujoco.MjModel) -> tuple[int, int]:
 
 
 class MujocoCpuBackend:
-    """B worlds of ``model`` on the CPU, ``threads`` C threads (1 = the calling thread)."""
+    """B worlds of ``model`` on the CPU, on ``threads`` threads (the calling thread and ``threads - 1`` helpers)."""
 
     def __init__(self, model: mujoco.MjModel, num_worlds: int, *, substeps: int, threads: int = 1) -> None:
         if threads < 1:
@@ -37,9 +38,7 @@ class MujocoCpuBackend:
         self.substeps = substeps
         self.threads = threads
         self.device = torch.device("cpu")
-        self._datas = [mujoco.MjData(model) for _ in range(threads)]
-        self._models = [model] * num_worlds
-        self._pool = rollout.Rollout(nthread=threads if threads > 1 else 0)
+        self._pool: RolloutThreads | None = RolloutThreads(model, threads, default_chunk_size(num_worlds, threads))
         self._nstate = mujoco.mj_stateSize(model, _FULL)
         self._qpos0, self._qvel0 = state_offsets(model)
         self.state = np.zeros((num_worlds, self._nstate))
@@ -49,7 +48,6 @@ class MujocoCpuBackend:
         self._ctrl = np.zeros((num_worlds, substeps, model.nu))
         self._out_state = np.zeros((num_worlds, substeps, self._nstate))
         self._out_sensor = np.zeros((num_worlds, substeps, model.nsensordata))
-        self._chunk = max(1, num_worlds // (threads * 10))
 
     @property
     def qpos(self) -> np.ndarray:
@@ -64,18 +62,7 @@ class MujocoCpuBackend:
     def step(self, ctrl: torch.Tensor) -> SimState:
         """Hold ``ctrl`` (B, nu) for ``substeps`` physics steps on every world, in C threads."""
         self._ctrl[:] = ctrl.detach().cpu().to(torch.float64).numpy()[:, None, :]
-        self._pool.rollout(
-            self._models,
-            self._datas,
-            self.state,
-            self._ctrl,
-            control_spec=_CTRL,
-            skip_checks=True,
-            nstep=self.substeps,
-            state=self._out_state,
-            sensordata=self._out_sensor,
-            chunk_size=self._chunk,
-        )
+        self._pool.run(self.state, self._ctrl, self._out_state, self._out_sensor, self.substeps)
         expected_time = self.state[:, 0] + (self.substeps - 0.5) * self.model.opt.timestep
         self.state[:] = self._out_state[:, -1]
         # MuJoCo resets a world whose qpos/qvel/qacc go non-finite or huge (time restarts at 0),
@@ -104,17 +91,12 @@ class MujocoCpuBackend:
         if n == 0:
             return torch.zeros((0, self.model.nsensordata), dtype=torch.float64)
         sensors = np.zeros((n, 1, self.model.nsensordata))
-        self._pool.rollout(
-            self._models[:n],
-            self._datas,
+        self._pool.run(
             np.ascontiguousarray(self.state[ids]),
             np.ascontiguousarray(ctrl.cpu().to(torch.float64).numpy()[:, None, :]),
-            control_spec=_CTRL,
-            skip_checks=True,
+            np.zeros((n, 1, self._nstate)),
+            sensors,
             nstep=1,
-            state=np.zeros((n, 1, self._nstate)),
-            sensordata=sensors,
-            chunk_size=max(1, n // (self.threads * 10)),
         )
         return torch.from_numpy(sensors[:, 0])
 

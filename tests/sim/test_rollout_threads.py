@@ -1,0 +1,107 @@
+"""RolloutThreads against one plain single-thread ``rollout`` call over the whole batch (the reference)."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from mujoco import rollout
+
+from roto.robots import get_robot
+from roto.sim.rollout_threads import RolloutThreads, default_chunk_size
+from roto.sim.scene import build_scene
+from roto.tasks.bounce import BALL
+
+_FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
+_CTRL = mujoco.mjtState.mjSTATE_CTRL.value
+
+
+@pytest.fixture(scope="module")
+def batch() -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
+    """Allegro with a ball; 13 worlds with different joint offsets and random targets held 3 steps."""
+    model, layout = build_scene(get_robot("allegro"), (BALL,))
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(0)
+    states = []
+    for _ in range(13):
+        data.qpos[:] = layout.default_qpos
+        data.qpos[layout.act_qpos] += rng.uniform(-0.1, 0.1, len(layout.act_qpos))
+        data.qpos[layout.ball_qpos[0] + 2] = 0.06  # the ball just above the palm: contacts in some worlds
+        state = np.zeros(mujoco.mj_stateSize(model, _FULL))
+        mujoco.mj_getState(model, data, state, _FULL)
+        states.append(state)
+    ctrl = rng.uniform(layout.ctrl_lo, layout.ctrl_hi, (13, 3, model.nu))
+    return model, np.stack(states), ctrl
+
+
+def _reference(model: mujoco.MjModel, state0: np.ndarray, ctrl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    n, nstep = ctrl.shape[:2]
+    state = np.zeros((n, nstep, state0.shape[1]))
+    sensordata = np.zeros((n, nstep, model.nsensordata))
+    rollout.Rollout(nthread=0).rollout(
+        [model] * n,
+        [mujoco.MjData(model)],
+        state0,
+        ctrl,
+        control_spec=_CTRL,
+        nstep=nstep,
+        state=state,
+        sensordata=sensordata,
+    )
+    return state, sensordata
+
+
+@pytest.mark.parametrize(("threads", "chunk_size"), [(1, 13), (1, 4), (2, 1), (2, 5), (3, 2), (2, 100)])
+def test_matches_one_single_thread_rollout(batch, threads: int, chunk_size: int) -> None:
+    model, state0, ctrl = batch
+    expected_state, expected_sensors = _reference(model, state0, ctrl)
+    pool = RolloutThreads(model, threads, chunk_size)
+    try:
+        for _ in range(3):  # reuse of the helpers across calls
+            state = np.full_like(expected_state, np.nan)
+            sensordata = np.full_like(expected_sensors, np.nan)
+            pool.run(state0, ctrl, state, sensordata, nstep=3)
+            np.testing.assert_array_equal(state, expected_state)
+            np.testing.assert_array_equal(sensordata, expected_sensors)
+    finally:
+        pool.close()
+
+
+def test_an_error_reaches_the_caller_and_the_pool_stays_usable(batch) -> None:
+    model, state0, ctrl = batch
+    pool = RolloutThreads(model, 2, 2)
+    try:
+        too_small = np.zeros((13, 2, state0.shape[1]))  # room for 2 steps, 3 asked for
+        with pytest.raises(ValueError, match=r"state\.size"):
+            pool.run(state0, ctrl, too_small, np.zeros((13, 3, model.nsensordata)), nstep=3)
+        expected_state, _ = _reference(model, state0, ctrl)
+        state = np.zeros_like(expected_state)
+        pool.run(state0, ctrl, state, np.zeros((13, 3, model.nsensordata)), nstep=3)
+        np.testing.assert_array_equal(state, expected_state)
+    finally:
+        pool.close()
+
+
+def test_close_is_idempotent_and_final(batch) -> None:
+    model, state0, ctrl = batch
+    pool = RolloutThreads(model, 2, 4)
+    pool.close()
+    pool.close()
+    assert not any(thread.is_alive() for thread in pool._helpers)
+    with pytest.raises(RuntimeError, match="closed"):
+        pool.run(state0, ctrl, np.zeros((13, 3, state0.shape[1])), np.zeros((13, 3, model.nsensordata)), nstep=3)
+
+
+def test_bad_settings_are_refused(batch) -> None:
+    model = batch[0]
+    with pytest.raises(ValueError, match="threads must be >= 1, got 0"):
+        RolloutThreads(model, 0, 4)
+    with pytest.raises(ValueError, match="chunk_size must be >= 1, got 0"):
+        RolloutThreads(model, 2, 0)
+
+
+def test_default_chunk_size() -> None:
+    assert default_chunk_size(256, 1) == 256  # one rollout call on the calling thread
+    assert default_chunk_size(256, 2) == 16
+    assert default_chunk_size(8, 2) == 1
+    assert default_chunk_size(4096, 4) == 16
