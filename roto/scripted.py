@@ -144,7 +144,7 @@ class ScriptedBounce:
         idx = env._idx
         self._lo, self._hi = idx.ctrl_lo, idx.ctrl_hi
         joints = env.robot.actuated_joints
-        self._pose = idx.default_qpos[0, idx.act_qpos].clone()
+        self._pose = idx.act_qpos.take(idx.default_qpos)[0].clone()
         for joint, angle in script.pose.items():
             self._pose[joints.index(joint)] = angle
         self._swing = torch.tensor([joints.index(j) for j in script.swing], dtype=torch.int64)

@@ -16,6 +16,7 @@ import numpy as np
 import torch
 
 from roto.envs.capacity import warp_capacity
+from roto.envs.columns import Columns
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
 from roto.envs.observations import OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
@@ -204,7 +205,7 @@ class RotoEnv:
     def hold_action(self) -> torch.Tensor:
         """(1, num_actions) float32 action whose joint targets are the default (cupped) pose."""
         idx = self._idx
-        return target_to_action(idx.default_qpos[:, idx.act_qpos], idx.ctrl_lo, idx.ctrl_hi).to(torch.float32)
+        return target_to_action(idx.act_qpos.take(idx.default_qpos), idx.ctrl_lo, idx.ctrl_hi).to(torch.float32)
 
     @property
     def unwrapped(self) -> RotoEnv:
@@ -241,9 +242,10 @@ class RotoEnv:
 
     def _task_inputs(self, qpos: torch.Tensor, qvel: torch.Tensor, sensors: torch.Tensor) -> TaskInputs:
         idx = self._idx
-        ball_pos = qpos[:, idx.ball_pos]
-        ball_vel = qvel[:, idx.ball_vel]
-        contact = (sensors[:, :, idx.ball_force] > self.config.tactile_threshold).any(dim=1)
+        # views of the backend's state: read before the step's resets overwrite it
+        ball_pos = idx.ball_pos.take(qpos)
+        ball_vel = idx.ball_vel.take(qvel)
+        contact = (idx.ball_force.take(sensors) > self.config.tactile_threshold).any(dim=1)
         return TaskInputs(ball_pos=ball_pos, ball_vel=ball_vel, ball_contact=contact)
 
     def _frame(
@@ -259,14 +261,14 @@ class RotoEnv:
         idx = self._idx
         groups: dict[str, torch.Tensor] = {}
         if "tactile" in self.groups:
-            groups["tactile"] = tactile_bits(sensors_now[:, idx.tactile_force], self.config.tactile_threshold)
+            groups["tactile"] = tactile_bits(idx.tactile_force.take(sensors_now), self.config.tactile_threshold)
         groups["proprio"] = proprio_frame(
-            qpos[:, idx.obs_qpos],
-            qvel[:, idx.obs_qvel],
+            idx.obs_qpos.take(qpos),
+            idx.obs_qvel.take(qvel),
             idx.obs_lo,
             idx.obs_hi,
             target,
-            qpos[:, idx.act_qpos],
+            idx.act_qpos.take(qpos),
             last_action,
         )
         if "privileged" in self.groups:
@@ -278,16 +280,16 @@ class RotoEnv:
         n = len(env_ids)
         idx = self._idx
         qpos = idx.default_qpos.expand(n, -1).clone()
-        noise = uniform(self._generator, (n, len(idx.act_qpos)), self.config.reset_joint_noise, self.device)
-        qpos[:, idx.act_qpos] = torch.clamp(qpos[:, idx.act_qpos] + noise, idx.ctrl_lo, idx.ctrl_hi)
-        qpos[:, idx.coupled_driven] = torch.clamp(
-            qpos[:, idx.coupled_driver] * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi
+        noise = uniform(self._generator, (n, self.num_actions), self.config.reset_joint_noise, self.device)
+        idx.act_qpos.put(qpos, torch.clamp(idx.act_qpos.take(qpos) + noise, idx.ctrl_lo, idx.ctrl_hi))
+        idx.coupled_driven.put(
+            qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
         )
         ball_pos = self.task.reset(self.task_state, env_ids, self._generator)
-        qpos[:, idx.ball_pos] = ball_pos.to(qpos.dtype)
-        qpos[:, idx.ball_quat] = idx.identity_quat
+        idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))
+        idx.ball_quat.put(qpos, idx.identity_quat)
         qvel = torch.zeros(n, self.model.nv, dtype=torch.float64, device=self.device)
-        target = qpos[:, idx.act_qpos]
+        target = idx.act_qpos.take(qpos).clone()
         sensors = self.backend.set_state(env_ids, qpos, qvel, target).to(self.device, torch.float64)
 
         self._target[env_ids] = target
@@ -296,7 +298,9 @@ class RotoEnv:
         self._episode.ret[env_ids] = 0.0
         for value in self._term_sums.values():
             value[env_ids] = 0.0
-        inputs = TaskInputs(ball_pos=qpos[:, idx.ball_pos], ball_vel=qvel[:, idx.ball_vel], ball_contact=torch.zeros(0))
+        inputs = TaskInputs(
+            ball_pos=idx.ball_pos.take(qpos), ball_vel=idx.ball_vel.take(qvel), ball_contact=torch.zeros(0)
+        )
         return self._frame(qpos, qvel, sensors, inputs, target, self._last_action[env_ids])
 
     def _episode_info(self, truncated: torch.Tensor) -> dict[str, torch.Tensor]:
@@ -312,24 +316,24 @@ class RotoEnv:
 
 @dataclass(frozen=True)
 class _Indices:
-    """Index tensors into qpos / qvel / sensordata, on the env's device."""
+    """Column selections of qpos / qvel / sensordata and constants, on the env's device."""
 
-    act_qpos: torch.Tensor
-    obs_qpos: torch.Tensor
-    obs_qvel: torch.Tensor
+    act_qpos: Columns
+    obs_qpos: Columns
+    obs_qvel: Columns
     obs_lo: torch.Tensor
     obs_hi: torch.Tensor
     ctrl_lo: torch.Tensor
     ctrl_hi: torch.Tensor
-    ball_pos: torch.Tensor  # (n_ball, 3) qpos indices of each ball's centre
-    ball_quat: torch.Tensor  # (n_ball, 4)
-    ball_vel: torch.Tensor  # (n_ball, 3) qvel indices of each ball's linear velocity
-    tactile_force: torch.Tensor  # (n_links,) sensordata index of each link's normal force
-    ball_force: torch.Tensor  # (n_ball,) sensordata index of each ball-hand normal force
+    ball_pos: Columns  # (n_ball, 3) qpos indices of each ball's centre
+    ball_quat: Columns  # (n_ball, 4)
+    ball_vel: Columns  # (n_ball, 3) qvel indices of each ball's linear velocity
+    tactile_force: Columns  # (n_links,) sensordata index of each link's normal force
+    ball_force: Columns  # (n_ball,) sensordata index of each ball-hand normal force
     default_qpos: torch.Tensor  # (1, nq)
     identity_quat: torch.Tensor  # (4,)
-    coupled_driven: torch.Tensor
-    coupled_driver: torch.Tensor
+    coupled_driven: Columns
+    coupled_driver: Columns
     coupled_ratio: torch.Tensor
     coupled_lo: torch.Tensor
     coupled_hi: torch.Tensor
@@ -338,6 +342,9 @@ class _Indices:
     def from_layout(cls, layout: SceneLayout, robot: RobotSpec, model: Any, device: torch.device) -> _Indices:
         def t(array: Any, dtype: torch.dtype = torch.int64) -> torch.Tensor:
             return torch.as_tensor(np.asarray(array), dtype=dtype, device=device)
+
+        def c(array: Any) -> Columns:
+            return Columns.of(np.asarray(array, dtype=np.int64), device)
 
         f64 = torch.float64
         driven = [model.joint(j).qposadr[0] for j in robot.coupled_joints]
@@ -349,22 +356,22 @@ class _Indices:
                 ratio * default[model.joint(d).qposadr[0]], *model.jnt_range[model.joint(j).id]
             )
         return cls(
-            act_qpos=t(layout.act_qpos),
-            obs_qpos=t(layout.obs_qpos),
-            obs_qvel=t(layout.obs_qvel),
+            act_qpos=c(layout.act_qpos),
+            obs_qpos=c(layout.obs_qpos),
+            obs_qvel=c(layout.obs_qvel),
             obs_lo=t(layout.obs_lo, f64),
             obs_hi=t(layout.obs_hi, f64),
             ctrl_lo=t(layout.ctrl_lo, f64),
             ctrl_hi=t(layout.ctrl_hi, f64),
-            ball_pos=t(layout.ball_qpos[:, None] + np.arange(3)),
-            ball_quat=t(layout.ball_qpos[:, None] + 3 + np.arange(4)),
-            ball_vel=t(layout.ball_qvel[:, None] + np.arange(3)),
-            tactile_force=t(layout.tactile_sensor + 1),
-            ball_force=t(layout.ball_contact_sensor + 1),
+            ball_pos=c(layout.ball_qpos[:, None] + np.arange(3)),
+            ball_quat=c(layout.ball_qpos[:, None] + 3 + np.arange(4)),
+            ball_vel=c(layout.ball_qvel[:, None] + np.arange(3)),
+            tactile_force=c(layout.tactile_sensor + 1),
+            ball_force=c(layout.ball_contact_sensor + 1),
             default_qpos=t(default, f64)[None],
             identity_quat=t([1.0, 0.0, 0.0, 0.0], f64),
-            coupled_driven=t(driven),
-            coupled_driver=t(driver),
+            coupled_driven=c(driven),
+            coupled_driver=c(driver),
             coupled_ratio=t([r for _, r in robot.coupled_joints.values()], f64),
             coupled_lo=t(model.jnt_range[driven_ids, 0] if driven_ids else [], f64),
             coupled_hi=t(model.jnt_range[driven_ids, 1] if driven_ids else [], f64),

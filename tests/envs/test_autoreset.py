@@ -23,7 +23,7 @@ def test_episode_info_and_final_obs_on_termination():
     # move every ball far below the palm: all three terminate on the next step
     state = env.backend.state
     qpos = torch.from_numpy(env.backend.qpos.copy())
-    qpos[:, env._idx.ball_pos[0, 2]] = -0.5
+    qpos[:, env._idx.ball_pos.index[0, 2]] = -0.5
     env.backend.set_state(torch.arange(3), qpos, torch.zeros(3, env.model.nv), torch.zeros(3, 20))
     obs, _, terminated, truncated, info = env.step(torch.zeros(3, 20))
     assert terminated.all() and not truncated.any()

@@ -122,7 +122,7 @@ def test_held_baoding_balls_and_their_lift_read_the_same_on_both_backends(name):
     assert tactile[0][-1][0, -n_links:].sum() > 0
     for env in envs:  # lift both balls 30 cm: every bit clears within one step on both
         qpos = physics(env)[:, 1 : 1 + env.model.nq]
-        qpos[0, idx.ball_pos[:, 2]] = 0.3
+        qpos[0, idx.ball_pos.index[:, 2]] = 0.3
         env.backend.set_state(torch.tensor([0]), qpos, torch.zeros(1, env.model.nv), env._target)
         assert env.step(hold)[0]["tactile"][0, -n_links:].sum() == 0
 
