@@ -8,6 +8,8 @@ One ``step`` runs, in this order (DESIGN §1):
 from __future__ import annotations
 
 import dataclasses
+import functools
+import operator
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -130,13 +132,14 @@ class RotoEnv:
 
         inputs = self._task_inputs(qpos, qvel, sensors)
         result = self.task.step(self.task_state, inputs)
-        reward = sum(result.reward_terms.values())
-        reward = torch.where(diverged, torch.zeros_like(reward), reward)
+        reward = functools.reduce(operator.add, result.reward_terms.values()).masked_fill(diverged, 0.0)
         self._episode.length += 1
         self._episode.ret += reward
         for name, value in result.reward_terms.items():
-            self._term_sums.setdefault(name, torch.zeros_like(value))
-            self._term_sums[name] += value
+            if name in self._term_sums:
+                self._term_sums[name] += value
+            else:
+                self._term_sums[name] = value.clone()
         terminated = result.terminated | diverged
         truncated = (self._episode.length >= self.config.episode_steps) & ~terminated
 
@@ -282,9 +285,10 @@ class RotoEnv:
         qpos = idx.default_qpos.expand(n, -1).clone()
         noise = uniform(self._generator, (n, self.num_actions), self.config.reset_joint_noise, self.device)
         idx.act_qpos.put(qpos, torch.clamp(idx.act_qpos.take(qpos) + noise, idx.ctrl_lo, idx.ctrl_hi))
-        idx.coupled_driven.put(
-            qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
-        )
+        if idx.coupled_driven.shape[0]:
+            idx.coupled_driven.put(
+                qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
+            )
         ball_pos = self.task.reset(self.task_state, env_ids, self._generator)
         idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))
         idx.ball_quat.put(qpos, idx.identity_quat)
