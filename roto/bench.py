@@ -27,10 +27,15 @@ def _random_actions(generator: torch.Generator, num_envs: int, num_actions: int,
     return torch.rand((steps, num_envs, num_actions), generator=generator) * 2.0 - 1.0
 
 
-def raw_physics_steps_per_s(env: Any, states: np.ndarray, ctrls: np.ndarray, substeps: int) -> float:
-    """Plain single-thread ``mj_step`` over the given states (B, nstate) and controls (B, nu)."""
+def raw_physics_seconds(
+    env: Any, states: np.ndarray, ctrls: np.ndarray, substeps: int, data: mujoco.MjData | None = None
+) -> float:
+    """Seconds of plain single-thread ``mj_step`` (``substeps`` each) from states (n, nstate), controls (n, nu).
+
+    ``data`` is the scratch ``MjData`` to step in (a new one if None).
+    """
     model = env.model
-    data = mujoco.MjData(model)
+    data = mujoco.MjData(model) if data is None else data
     full = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
     elapsed = 0.0
     for state, ctrl in zip(states, ctrls, strict=True):
@@ -39,7 +44,12 @@ def raw_physics_steps_per_s(env: Any, states: np.ndarray, ctrls: np.ndarray, sub
         start = time.perf_counter()
         mujoco.mj_step(model, data, nstep=substeps)
         elapsed += time.perf_counter() - start
-    return len(states) * substeps / elapsed
+    return elapsed
+
+
+def raw_physics_steps_per_s(env: Any, states: np.ndarray, ctrls: np.ndarray, substeps: int) -> float:
+    """Plain single-thread ``mj_step`` over the given states (B, nstate) and controls (B, nu)."""
+    return len(states) * substeps / raw_physics_seconds(env, states, ctrls, substeps)
 
 
 def run_bench(
@@ -98,21 +108,27 @@ def run_bench(
 
 
 def _time_cpu(env: Any, actions: torch.Tensor) -> tuple[float, float]:
-    """(env steps/s, single-thread raw physics steps/s) over ``actions`` (steps, B, n)."""
-    wall = 0.0
-    raw_rates = []
-    steps = len(actions)
-    sample_every = max(1, steps // 4)
-    for t in range(steps):
-        if t % sample_every == 0:
-            # the raw-physics reference runs on the env's own current states and targets
-            raw_rates.append(
-                raw_physics_steps_per_s(env, env.backend.physics_state(), env._target.numpy(), env.config.substeps)
-            )
+    """(env steps/s, single-thread raw physics steps/s) over ``actions`` (steps, B, n), interleaved.
+
+    After every env step, plain ``mj_step`` runs on the next eighth of the env's worlds (their
+    current states and targets), rotating through all of them. Both figures thus sample the same
+    stretches of time, so a slow spell of a shared machine slows both alike instead of only one.
+    """
+    num_envs, substeps = env.num_envs, env.config.substeps
+    share = max(1, num_envs // 8)
+    scratch = mujoco.MjData(env.model)
+    env_seconds = raw_seconds = 0.0
+    raw_steps = 0
+    for t, action in enumerate(actions):
         start = time.perf_counter()
-        env.step(actions[t])
-        wall += time.perf_counter() - start
-    return env.num_envs * steps / wall, float(np.mean(raw_rates))
+        env.step(action)
+        env_seconds += time.perf_counter() - start
+        first = (t * share) % num_envs
+        worlds = slice(first, min(num_envs, first + share))
+        states = env.backend.physics_state()[worlds]
+        raw_seconds += raw_physics_seconds(env, states, env._target[worlds].numpy(), substeps, scratch)
+        raw_steps += len(states) * substeps
+    return num_envs * len(actions) / env_seconds, raw_steps / raw_seconds
 
 
 def _synchronize(device: torch.device) -> None:
