@@ -14,8 +14,10 @@ result: 1 and K threads are bit-identical.
 
 from __future__ import annotations
 
+import os
 import queue
 import threading
+import weakref
 
 import mujoco
 import numpy as np
@@ -33,7 +35,12 @@ def default_chunk_size(num_worlds: int, threads: int) -> int:
 
 
 class RolloutThreads:
-    """``threads`` threads (the caller and ``threads - 1`` persistent helpers) over one model."""
+    """``threads`` threads (the caller and ``threads - 1`` persistent helpers) over one model.
+
+    Helpers hold the pool only weakly: a pool that is dropped without ``close()`` stops its
+    helpers when it is garbage-collected. After a ``fork`` the child starts helpers of its own
+    (threads do not survive a fork).
+    """
 
     def __init__(self, model: mujoco.MjModel, threads: int, chunk_size: int) -> None:
         if threads < 1:
@@ -49,15 +56,8 @@ class RolloutThreads:
         self._job: tuple[np.ndarray, ...] | None = None
         self._nstep = 0
         self._next = 0
-        self._todo: list[queue.SimpleQueue] = [queue.SimpleQueue() for _ in range(threads - 1)]
-        self._done: queue.SimpleQueue = queue.SimpleQueue()
         self._closed = False
-        self._helpers = [
-            threading.Thread(target=self._helper_loop, args=(k + 1,), name=f"roto-rollout-{k + 1}", daemon=True)
-            for k in range(threads - 1)
-        ]
-        for helper in self._helpers:
-            helper.start()
+        self._start_helpers()
 
     def run(self, state0: np.ndarray, ctrl: np.ndarray, state: np.ndarray, sensordata: np.ndarray, nstep: int) -> None:
         """Roll every world ``nstep`` physics steps; fills the output arrays in place.
@@ -70,6 +70,8 @@ class RolloutThreads:
         """
         if self._closed:
             raise RuntimeError("RolloutThreads was closed")
+        if os.getpid() != self._pid:
+            self._start_helpers()
         n = len(state0)
         if n == 0:
             return
@@ -97,13 +99,29 @@ class RolloutThreads:
 
     def close(self) -> None:
         """Stop the helper threads (idempotent)."""
-        for todo in self._todo:
-            todo.put(False)
+        self._stop()
         for helper in self._helpers:
             helper.join()
-        self._todo = []
         self._helpers = []
         self._closed = True
+
+    def _start_helpers(self) -> None:
+        """Fresh queues and ``threads - 1`` helper threads for this process."""
+        self._pid = os.getpid()
+        self._todo: list[queue.SimpleQueue] = [queue.SimpleQueue() for _ in range(self.threads - 1)]
+        self._done: queue.SimpleQueue = queue.SimpleQueue()
+        self._stop = weakref.finalize(self, _stop_helpers, self._todo)
+        self._helpers = [
+            threading.Thread(
+                target=_helper_loop,
+                args=(weakref.ref(self), k + 1, self._todo[k], self._done),
+                name=f"roto-rollout-{k + 1}",
+                daemon=True,
+            )
+            for k in range(self.threads - 1)
+        ]
+        for helper in self._helpers:
+            helper.start()
 
     def _work(self, thread: int) -> None:
         """Take chunks of the current job until none is left, stepping them on ``thread``'s data."""
@@ -129,12 +147,23 @@ class RolloutThreads:
                 sensordata=sensordata[start:end],
             )
 
-    def _helper_loop(self, thread: int) -> None:
-        todo = self._todo[thread - 1]
-        while todo.get():
-            try:
-                self._work(thread)
-            except BaseException as error:  # handed to the caller's run()
-                self._done.put(error)
-            else:
-                self._done.put(None)
+
+def _stop_helpers(todo: list[queue.SimpleQueue]) -> None:
+    """Tell every helper to exit (runs at ``close()`` or when the pool is garbage-collected)."""
+    for queue_ in todo:
+        queue_.put(False)
+
+
+def _helper_loop(pool_ref: weakref.ref, thread: int, todo: queue.SimpleQueue, done: queue.SimpleQueue) -> None:
+    """Wait for work, step chunks as ``thread``, report; hold the pool only while working."""
+    while todo.get():
+        pool = pool_ref()
+        if pool is None:
+            return
+        try:
+            pool._work(thread)
+        except BaseException as error:  # handed to the caller's run()
+            done.put(error)
+        else:
+            done.put(None)
+        pool = None  # no strong reference while waiting, so a dropped pool can be collected

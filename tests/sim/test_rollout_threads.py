@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import gc
+import multiprocessing
+
 import mujoco
 import numpy as np
 import pytest
@@ -85,11 +88,52 @@ def test_an_error_reaches_the_caller_and_the_pool_stays_usable(batch) -> None:
 def test_close_is_idempotent_and_final(batch) -> None:
     model, state0, ctrl = batch
     pool = RolloutThreads(model, 2, 4)
+    helpers = list(pool._helpers)
+    assert helpers and all(helper.is_alive() for helper in helpers)
     pool.close()
     pool.close()
-    assert not any(thread.is_alive() for thread in pool._helpers)
+    assert not any(helper.is_alive() for helper in helpers)
     with pytest.raises(RuntimeError, match="closed"):
         pool.run(state0, ctrl, np.zeros((13, 3, state0.shape[1])), np.zeros((13, 3, model.nsensordata)), nstep=3)
+
+
+def test_a_dropped_pool_stops_its_helpers(batch) -> None:
+    model, state0, ctrl = batch
+    pool = RolloutThreads(model, 3, 2)
+    pool.run(state0, ctrl, np.zeros((13, 3, state0.shape[1])), np.zeros((13, 3, model.nsensordata)), nstep=3)
+    helpers = list(pool._helpers)
+    del pool
+    gc.collect()
+    for helper in helpers:
+        helper.join(timeout=10)
+    assert not any(helper.is_alive() for helper in helpers)
+
+
+def _run_in_child(pool: RolloutThreads, state0: np.ndarray, ctrl: np.ndarray, conn) -> None:
+    state = np.zeros((len(state0), ctrl.shape[1], state0.shape[1]))
+    pool.run(state0, ctrl, state, np.zeros((len(state0), ctrl.shape[1], pool.model.nsensordata)), nstep=ctrl.shape[1])
+    conn.send(state)
+
+
+def test_a_forked_child_starts_its_own_helpers(batch) -> None:
+    model, state0, ctrl = batch
+    expected_state, _ = _reference(model, state0, ctrl)
+    pool = RolloutThreads(model, 2, 2)
+    try:
+        context = multiprocessing.get_context("fork")
+        receive, send = context.Pipe(duplex=False)
+        child = context.Process(target=_run_in_child, args=(pool, state0, ctrl, send), daemon=True)
+        child.start()
+        try:
+            assert receive.poll(60), "the forked child did not finish its rollout"
+            np.testing.assert_array_equal(receive.recv(), expected_state)
+            child.join(timeout=10)
+            assert child.exitcode == 0
+        finally:
+            if child.is_alive():
+                child.kill()
+    finally:
+        pool.close()
 
 
 def test_bad_settings_are_refused(batch) -> None:
