@@ -37,10 +37,15 @@ def batch() -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
     return model, np.stack(states), ctrl
 
 
+def _outputs(model: mujoco.MjModel, ctrl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Zeroed (state, sensordata) output arrays for controls ``ctrl`` (n, nstep, nu)."""
+    n, nstep = ctrl.shape[:2]
+    return np.zeros((n, nstep, mujoco.mj_stateSize(model, _FULL))), np.zeros((n, nstep, model.nsensordata))
+
+
 def _reference(model: mujoco.MjModel, state0: np.ndarray, ctrl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     n, nstep = ctrl.shape[:2]
-    state = np.zeros((n, nstep, state0.shape[1]))
-    sensordata = np.zeros((n, nstep, model.nsensordata))
+    state, sensordata = _outputs(model, ctrl)
     rollout.Rollout(nthread=0).rollout(
         [model] * n,
         [mujoco.MjData(model)],
@@ -74,13 +79,11 @@ def test_an_error_reaches_the_caller_and_the_pool_stays_usable(batch) -> None:
     model, state0, ctrl = batch
     pool = RolloutThreads(model, 2, 2)
     try:
-        too_small = np.zeros((13, 2, state0.shape[1]))  # room for 2 steps, 3 asked for
+        state, sensordata = _outputs(model, ctrl)
         with pytest.raises(ValueError, match=r"state\.size"):
-            pool.run(state0, ctrl, too_small, np.zeros((13, 3, model.nsensordata)), nstep=3)
-        expected_state, _ = _reference(model, state0, ctrl)
-        state = np.zeros_like(expected_state)
-        pool.run(state0, ctrl, state, np.zeros((13, 3, model.nsensordata)), nstep=3)
-        np.testing.assert_array_equal(state, expected_state)
+            pool.run(state0, ctrl, state[:, :2], sensordata, nstep=3)  # room for 2 steps, 3 asked for
+        pool.run(state0, ctrl, state, sensordata, nstep=3)
+        np.testing.assert_array_equal(state, _reference(model, state0, ctrl)[0])
     finally:
         pool.close()
 
@@ -94,13 +97,13 @@ def test_close_is_idempotent_and_final(batch) -> None:
     pool.close()
     assert not any(helper.is_alive() for helper in helpers)
     with pytest.raises(RuntimeError, match="closed"):
-        pool.run(state0, ctrl, np.zeros((13, 3, state0.shape[1])), np.zeros((13, 3, model.nsensordata)), nstep=3)
+        pool.run(state0, ctrl, *_outputs(model, ctrl), nstep=3)
 
 
 def test_a_dropped_pool_stops_its_helpers(batch) -> None:
     model, state0, ctrl = batch
     pool = RolloutThreads(model, 3, 2)
-    pool.run(state0, ctrl, np.zeros((13, 3, state0.shape[1])), np.zeros((13, 3, model.nsensordata)), nstep=3)
+    pool.run(state0, ctrl, *_outputs(model, ctrl), nstep=3)
     helpers = list(pool._helpers)
     del pool
     gc.collect()
@@ -110,8 +113,8 @@ def test_a_dropped_pool_stops_its_helpers(batch) -> None:
 
 
 def _run_in_child(pool: RolloutThreads, state0: np.ndarray, ctrl: np.ndarray, conn) -> None:
-    state = np.zeros((len(state0), ctrl.shape[1], state0.shape[1]))
-    pool.run(state0, ctrl, state, np.zeros((len(state0), ctrl.shape[1], pool.model.nsensordata)), nstep=ctrl.shape[1])
+    state, sensordata = _outputs(pool.model, ctrl)
+    pool.run(state0, ctrl, state, sensordata, nstep=ctrl.shape[1])
     conn.send(state)
 
 
