@@ -2,7 +2,7 @@
 
 ``rollout``'s own pool (``Rollout(nthread=K)``) leaves the calling thread asleep while K workers
 step the batch, and all K workers are woken from sleep at every control step, after the env's
-torch work on the calling thread. On the 2-core project machine that made 2-thread physics 8-12 %
+torch work on the calling thread. On the 2-core project machine that made 2-thread physics 8-13 %
 slower (benchmarks/README.md). Here the calling thread steps worlds itself and only ``threads - 1``
 helpers are woken; every thread takes chunks of worlds from a shared counter until none is left,
 so a thread that drew cheap worlds takes more of them.
