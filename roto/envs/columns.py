@@ -32,20 +32,15 @@ class Columns:
     col_step: int
 
     @classmethod
-    def of(cls, index: np.ndarray | list | torch.Tensor, device: torch.device | str = "cpu") -> Columns:
+    def of(cls, index: np.ndarray | list, device: torch.device | str = "cpu") -> Columns:
         """Selector for the integer ``index`` (1-D or 2-D)."""
-        array = np.asarray(index.cpu() if isinstance(index, torch.Tensor) else index, dtype=np.int64)
+        array = np.asarray(index, dtype=np.int64)
         if array.ndim not in (1, 2):
             raise ValueError(f"column index must be 1-D or 2-D, got shape {array.shape}")
-        tensor = torch.as_tensor(array, dtype=torch.int64, device=device)
+        tensor = torch.as_tensor(array, device=device)
         grid = _grid(array if array.ndim == 2 else array[None])
         start, row_step, col_step = grid if grid is not None else (None, 0, 0)
         return cls(index=tensor, start=start, row_step=row_step, col_step=col_step)
-
-    @property
-    def shape(self) -> tuple[int, ...]:
-        """Shape of the index, which ``take`` appends to the leading axes."""
-        return tuple(self.index.shape)
 
     def take(self, x: torch.Tensor) -> torch.Tensor:
         """``x[..., index]``, shape ``(*x.shape[:-1], *index.shape)``: a view of ``x`` where possible."""
@@ -61,24 +56,17 @@ class Columns:
             view.copy_(values)
 
     def _view(self, x: torch.Tensor) -> torch.Tensor | None:
-        """The selection as a view of ``x``, or None where it is not a grid that fits in ``x``."""
+        """The selection as a strided view of ``x``, or None where it is not a grid that fits in ``x``."""
         if self.start is None:
             return None
-        k = self.index.shape[-1]
-        span = self.col_step * (k - 1) + 1
-        if self.index.dim() == 1 or self.index.shape[0] == 1:
-            if self.start + span > x.shape[-1]:
-                return None
-            view = x[..., self.start : self.start + span : self.col_step]
-            return view if self.index.dim() == 1 else view.unsqueeze(-2)
-        n = self.index.shape[0]
-        if self.start + self.row_step * (n - 1) + span > x.shape[-1]:
+        grid = self.index if self.index.dim() == 2 else self.index[None]
+        n, k = grid.shape
+        if self.start + self.row_step * (n - 1) + self.col_step * (k - 1) >= x.shape[-1]:
             return None
         unit = x.stride(-1)
+        strides = (self.row_step * unit, self.col_step * unit)[-self.index.dim() :]
         return x.as_strided(
-            (*x.shape[:-1], n, k),
-            (*x.stride()[:-1], self.row_step * unit, self.col_step * unit),
-            x.storage_offset() + self.start * unit,
+            (*x.shape[:-1], *self.index.shape), (*x.stride()[:-1], *strides), x.storage_offset() + self.start * unit
         )
 
 
@@ -89,7 +77,7 @@ def _grid(index: np.ndarray) -> tuple[int, int, int] | None:
         return None
     start = int(index[0, 0])
     col_step = int(index[0, 1] - index[0, 0]) if k > 1 else 1
-    row_step = int(index[1, 0] - index[0, 0]) if n > 1 else col_step * (k - 1) + 1
+    row_step = int(index[1, 0] - index[0, 0]) if n > 1 else col_step * k  # one row: any step past it
     if col_step < 1 or row_step < col_step * (k - 1) + 1 or start < 0:
         return None
     expected = start + row_step * np.arange(n)[:, None] + col_step * np.arange(k)[None]

@@ -285,10 +285,9 @@ class RotoEnv:
         qpos = idx.default_qpos.expand(n, -1).clone()
         noise = uniform(self._generator, (n, self.num_actions), self.config.reset_joint_noise, self.device)
         idx.act_qpos.put(qpos, torch.clamp(idx.act_qpos.take(qpos) + noise, idx.ctrl_lo, idx.ctrl_hi))
-        if idx.coupled_driven.shape[0]:
-            idx.coupled_driven.put(
-                qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
-            )
+        idx.coupled_driven.put(
+            qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
+        )
         ball_pos = self.task.reset(self.task_state, env_ids, self._generator)
         idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))
         idx.ball_quat.put(qpos, idx.identity_quat)
@@ -348,7 +347,7 @@ class _Indices:
             return torch.as_tensor(np.asarray(array), dtype=dtype, device=device)
 
         def c(array: Any) -> Columns:
-            return Columns.of(np.asarray(array, dtype=np.int64), device)
+            return Columns.of(array, device)
 
         f64 = torch.float64
         driven = [model.joint(j).qposadr[0] for j in robot.coupled_joints]
