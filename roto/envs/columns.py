@@ -59,14 +59,18 @@ class Columns:
         """The selection as a strided view of ``x``, or None where it is not a grid that fits in ``x``."""
         if self.start is None:
             return None
-        grid = self.index if self.index.dim() == 2 else self.index[None]
-        n, k = grid.shape
-        if self.start + self.row_step * (n - 1) + self.col_step * (k - 1) >= x.shape[-1]:
+        k = self.index.shape[-1]
+        stop = self.start + self.col_step * (k - 1) + 1
+        if self.index.dim() == 1:  # a plain slice: the cheapest view to make
+            return x[..., self.start : stop : self.col_step] if stop <= x.shape[-1] else None
+        n = self.index.shape[0]
+        if stop + self.row_step * (n - 1) > x.shape[-1]:
             return None
         unit = x.stride(-1)
-        strides = (self.row_step * unit, self.col_step * unit)[-self.index.dim() :]
         return x.as_strided(
-            (*x.shape[:-1], *self.index.shape), (*x.stride()[:-1], *strides), x.storage_offset() + self.start * unit
+            (*x.shape[:-1], n, k),
+            (*x.stride()[:-1], self.row_step * unit, self.col_step * unit),
+            x.storage_offset() + self.start * unit,
         )
 
 
