@@ -15,9 +15,12 @@ import numpy as np
 import torch
 
 from roto.sim.backend import SimState
-from roto.sim.rollout_threads import RolloutThreads, default_chunk_size
+from roto.sim.rollout_threads import RolloutThreads
 
 _FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
+_SERIAL_RESET_WORLDS = 32
+"""Resets of fewer worlds run their one sensor step on the calling thread alone: for the handful of
+worlds a step resets, waking a helper costs more than it saves (benchmarks/README.md)."""
 
 
 def state_offsets(model: mujoco.MjModel) -> tuple[int, int]:
@@ -38,7 +41,7 @@ class MujocoCpuBackend:
         self.substeps = substeps
         self.threads = threads
         self.device = torch.device("cpu")
-        self._pool: RolloutThreads | None = RolloutThreads(model, threads, default_chunk_size(num_worlds, threads))
+        self._pool: RolloutThreads | None = RolloutThreads(model, threads)
         self._nstate = mujoco.mj_stateSize(model, _FULL)
         self._qpos0, self._qvel0 = state_offsets(model)
         self.state = np.zeros((num_worlds, self._nstate))
@@ -97,6 +100,7 @@ class MujocoCpuBackend:
             np.zeros((n, 1, self._nstate)),
             sensors,
             nstep=1,
+            threads=1 if n < _SERIAL_RESET_WORLDS else None,
         )
         return torch.from_numpy(sensors[:, 0])
 

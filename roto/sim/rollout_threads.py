@@ -5,7 +5,13 @@ step the batch, and all K workers are woken from sleep at every control step, af
 torch work on the calling thread. On the 2-core project machine that made 2-thread physics 8-13 %
 slower (benchmarks/README.md). Here the calling thread steps worlds itself and only ``threads - 1``
 helpers are woken; every thread takes chunks of worlds from a shared counter until none is left,
-so a thread that drew cheap worlds takes more of them.
+so a thread that drew cheap worlds (or runs on a faster core) takes more of them.
+
+Chunks shrink as the batch runs out (a guided schedule): each take is a ``1 / (2·threads)`` share
+of the worlds still left, at least ``min_chunk``. Early chunks are large (few ``rollout`` calls),
+the last ones are a world or two, so the threads finish within about one world's physics of each
+other; with fixed chunks of 16 worlds the first thread done idled for half a chunk on average,
+3-6 % of a 2-thread step (benchmarks/README.md).
 
 Each world's result depends only on its own initial state and controls (``rollout`` sets the full
 physics state and zeroes the warm start per world), so how worlds fall to threads never changes a
@@ -14,6 +20,8 @@ result: 1 and K threads are bit-identical.
 
 from __future__ import annotations
 
+import functools
+import itertools
 import os
 import queue
 import threading
@@ -26,12 +34,25 @@ from mujoco import rollout
 _CTRL = mujoco.mjtState.mjSTATE_CTRL.value
 
 
-def default_chunk_size(num_worlds: int, threads: int) -> int:
-    """Worlds per chunk: all of them on one thread (one ``rollout`` call), else about 8 chunks
-    per thread of at most 16 worlds (256 worlds on 2 threads: 16)."""
-    if threads == 1:
-        return max(1, num_worlds)
-    return max(1, min(16, num_worlds // (8 * threads)))
+@functools.cache
+def chunk_ends(num_worlds: int, threads: int, min_chunk: int = 1) -> tuple[int, ...]:
+    """Where each take of ``chunk_sizes`` ends (cumulative sizes; cached, one entry per batch shape)."""
+    return tuple(itertools.accumulate(chunk_sizes(num_worlds, threads, min_chunk)))
+
+
+def chunk_sizes(num_worlds: int, threads: int, min_chunk: int = 1) -> list[int]:
+    """The guided schedule: the sizes of successive takes from ``num_worlds`` worlds.
+
+    One thread takes every world in one ``rollout`` call; K threads take ``remaining // (2K)``
+    worlds at a time, at least ``min_chunk`` (256 worlds on 2 threads: 64, 48, 36, 27, ..., 1).
+    """
+    sizes = []
+    remaining = num_worlds
+    while remaining > 0:
+        size = remaining if threads == 1 else min(remaining, max(min_chunk, remaining // (2 * threads)))
+        sizes.append(size)
+        remaining -= size
+    return sizes
 
 
 class RolloutThreads:
@@ -42,25 +63,35 @@ class RolloutThreads:
     (threads do not survive a fork).
     """
 
-    def __init__(self, model: mujoco.MjModel, threads: int, chunk_size: int) -> None:
+    def __init__(self, model: mujoco.MjModel, threads: int, min_chunk: int = 1) -> None:
         if threads < 1:
             raise ValueError(f"threads must be >= 1, got {threads}")
-        if chunk_size < 1:
-            raise ValueError(f"chunk_size must be >= 1, got {chunk_size}")
+        if min_chunk < 1:
+            raise ValueError(f"min_chunk must be >= 1, got {min_chunk}")
         self.model = model
         self.threads = threads
-        self.chunk_size = chunk_size
+        self.min_chunk = min_chunk
         self._rollouts = [rollout.Rollout(nthread=0) for _ in range(threads)]
         self._datas = [[mujoco.MjData(model)] for _ in range(threads)]
         self._lock = threading.Lock()
         self._job: tuple[np.ndarray, ...] | None = None
         self._nstep = 0
+        self._chunk_ends: tuple[int, ...] = ()
         self._next = 0
         self._closed = False
         self._start_helpers()
 
-    def run(self, state0: np.ndarray, ctrl: np.ndarray, state: np.ndarray, sensordata: np.ndarray, nstep: int) -> None:
-        """Roll every world ``nstep`` physics steps; fills the output arrays in place.
+    def run(
+        self,
+        state0: np.ndarray,
+        ctrl: np.ndarray,
+        state: np.ndarray,
+        sensordata: np.ndarray,
+        nstep: int,
+        threads: int | None = None,
+    ) -> None:
+        """Roll every world ``nstep`` physics steps on at most ``threads`` threads (None: all);
+        fills the output arrays in place.
 
         Args:
             state0: (n, nstate) float64 C-contiguous ``mjSTATE_FULLPHYSICS`` start states.
@@ -77,9 +108,10 @@ class RolloutThreads:
             return
         self._job = (state0, ctrl, state, sensordata)
         self._nstep = nstep
+        threads = self.threads if threads is None else max(1, min(threads, self.threads))
+        self._chunk_ends = chunk_ends(n, threads, self.min_chunk)
         self._next = 0
-        chunks = -(-n // self.chunk_size)
-        woken = min(len(self._todo), chunks - 1)
+        woken = min(threads - 1, len(self._chunk_ends) - 1)
         for k in range(woken):
             self._todo[k].put(True)
         errors: list[BaseException] = []
@@ -88,7 +120,7 @@ class RolloutThreads:
         except BaseException as error:  # re-raised below, once the helpers stop
             errors.append(error)
             with self._lock:
-                self._next = n  # let the helpers run out of work
+                self._next = len(self._chunk_ends)  # let the helpers run out of work
         for _ in range(woken):
             error = self._done.get()
             if error is not None:
@@ -126,15 +158,15 @@ class RolloutThreads:
     def _work(self, thread: int) -> None:
         """Take chunks of the current job until none is left, stepping them on ``thread``'s data."""
         state0, ctrl, state, sensordata = self._job
-        n = len(state0)
-        models = [self.model] * self.chunk_size
+        ends = self._chunk_ends
+        models = [self.model] * ends[0]  # the first chunk is the largest
         while True:
             with self._lock:
-                start = self._next
-                self._next += self.chunk_size
-            if start >= n:
+                chunk = self._next
+                self._next += 1
+            if chunk >= len(ends):
                 return
-            end = min(n, start + self.chunk_size)
+            start, end = ends[chunk - 1] if chunk else 0, ends[chunk]
             self._rollouts[thread].rollout(
                 models[: end - start],
                 self._datas[thread],

@@ -11,7 +11,7 @@ import pytest
 from mujoco import rollout
 
 from roto.robots import get_robot
-from roto.sim.rollout_threads import RolloutThreads, default_chunk_size
+from roto.sim.rollout_threads import RolloutThreads, chunk_ends, chunk_sizes
 from roto.sim.scene import build_scene
 from roto.tasks.bounce import BALL
 
@@ -59,16 +59,19 @@ def _reference(model: mujoco.MjModel, state0: np.ndarray, ctrl: np.ndarray) -> t
     return state, sensordata
 
 
-@pytest.mark.parametrize(("threads", "chunk_size"), [(1, 13), (1, 4), (2, 1), (2, 5), (3, 2), (2, 100)])
-def test_matches_one_single_thread_rollout(batch, threads: int, chunk_size: int) -> None:
+@pytest.mark.parametrize(
+    ("threads", "min_chunk", "run_threads"),
+    [(1, 1, None), (1, 4, None), (2, 1, None), (2, 5, None), (3, 2, None), (2, 100, None), (3, 1, 2), (2, 1, 1)],
+)
+def test_matches_one_single_thread_rollout(batch, threads: int, min_chunk: int, run_threads: int | None) -> None:
     model, state0, ctrl = batch
     expected_state, expected_sensors = _reference(model, state0, ctrl)
-    pool = RolloutThreads(model, threads, chunk_size)
+    pool = RolloutThreads(model, threads, min_chunk)
     try:
         for _ in range(3):  # reuse of the helpers across calls
             state = np.full_like(expected_state, np.nan)
             sensordata = np.full_like(expected_sensors, np.nan)
-            pool.run(state0, ctrl, state, sensordata, nstep=3)
+            pool.run(state0, ctrl, state, sensordata, nstep=3, threads=run_threads)
             np.testing.assert_array_equal(state, expected_state)
             np.testing.assert_array_equal(sensordata, expected_sensors)
     finally:
@@ -143,12 +146,39 @@ def test_bad_settings_are_refused(batch) -> None:
     model = batch[0]
     with pytest.raises(ValueError, match="threads must be >= 1, got 0"):
         RolloutThreads(model, 0, 4)
-    with pytest.raises(ValueError, match="chunk_size must be >= 1, got 0"):
+    with pytest.raises(ValueError, match="min_chunk must be >= 1, got 0"):
         RolloutThreads(model, 2, 0)
 
 
-def test_default_chunk_size() -> None:
-    assert default_chunk_size(256, 1) == 256  # one rollout call on the calling thread
-    assert default_chunk_size(256, 2) == 16
-    assert default_chunk_size(8, 2) == 1
-    assert default_chunk_size(4096, 4) == 16
+def test_guided_chunks_shrink_to_the_minimum_and_cover_every_world_once() -> None:
+    assert chunk_sizes(256, 1) == [256]  # one rollout call on the calling thread
+    assert chunk_sizes(256, 2)[:4] == [64, 48, 36, 27]  # a quarter of what is left, then less
+    assert chunk_sizes(256, 2)[-3:] == [1, 1, 1]
+    assert chunk_sizes(13, 2, min_chunk=5) == [5, 5, 3]
+    assert chunk_sizes(0, 2) == []
+    for worlds, threads, min_chunk in [(256, 2, 1), (4096, 4, 2), (7, 3, 1), (1, 2, 1), (100, 2, 100)]:
+        sizes = chunk_sizes(worlds, threads, min_chunk)
+        assert sum(sizes) == worlds and all(size >= 1 for size in sizes)
+        assert sizes == sorted(sizes, reverse=True)
+        assert all(size >= min(min_chunk, worlds) for size in sizes[:-1])
+        assert chunk_ends(worlds, threads, min_chunk)[-1] == worlds
+
+
+def test_a_run_limited_to_one_thread_wakes_no_helper(batch, monkeypatch) -> None:
+    model, state0, ctrl = batch
+    pool = RolloutThreads(model, 2, 1)
+    try:
+        used = set()
+        work = pool._work
+
+        def recording_work(thread: int) -> None:
+            used.add(thread)
+            work(thread)
+
+        monkeypatch.setattr(pool, "_work", recording_work)
+        pool.run(state0, ctrl, *_outputs(model, ctrl), nstep=3, threads=1)
+        assert used == {0}
+        pool.run(state0, ctrl, *_outputs(model, ctrl), nstep=3)
+        assert used == {0, 1}
+    finally:
+        pool.close()
