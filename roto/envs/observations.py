@@ -67,7 +67,7 @@ def privileged_frame(ball_pos: torch.Tensor, ball_vel: torch.Tensor) -> torch.Te
 
 
 class FrameStack:
-    """The last k frames of each group, oldest -> newest, flattened to (B, k·dim) per group."""
+    """The last k frames of each group, oldest -> newest, held flat as (B, k·dim) per group."""
 
     def __init__(self, k: int) -> None:
         if k < 1:
@@ -78,25 +78,25 @@ class FrameStack:
     def reset(self, frame: dict[str, torch.Tensor], env_ids: torch.Tensor | None = None) -> None:
         """Fill the stack of ``env_ids`` (all if None) with k copies of ``frame`` ((n, dim) per group)."""
         for name, value in frame.items():
-            copies = value[:, None, :].expand(-1, self.k, -1)
+            copies = value.repeat(1, self.k)
             if env_ids is None:
-                self._frames[name] = copies.clone()
+                self._frames[name] = copies
             else:
                 self._frames[name][env_ids] = copies
 
     def push(self, frame: dict[str, torch.Tensor]) -> None:
         """Append one frame ((B, dim) per group), dropping the oldest."""
         for name, value in frame.items():
-            self._frames[name] = torch.cat([self._frames[name][:, 1:], value[:, None, :]], dim=1)
+            self._frames[name] = torch.cat([self._frames[name][:, value.shape[-1] :], value], dim=1)
 
     def state_dict(self) -> dict[str, torch.Tensor]:
         """Copies of the stacked frames, (B, k, dim) per group."""
-        return {name: frames.clone() for name, frames in self._frames.items()}
+        return {name: frames.unflatten(1, (self.k, -1)).clone() for name, frames in self._frames.items()}
 
     def load_state_dict(self, state: dict[str, torch.Tensor]) -> None:
         """Restore what ``state_dict`` returned."""
-        self._frames = {name: frames.clone() for name, frames in state.items()}
+        self._frames = {name: frames.flatten(1).clone() for name, frames in state.items()}
 
     def observation(self) -> dict[str, torch.Tensor]:
         """(B, k·dim) per group; fresh tensors each step, never views of internal buffers."""
-        return {name: frames.flatten(1).clone() for name, frames in self._frames.items()}
+        return {name: frames.clone() for name, frames in self._frames.items()}

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import operator
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -144,7 +145,6 @@ class RotoEnv:
         truncated = (self._episode.length >= self.config.episode_steps) & ~terminated
 
         frame = self._frame(qpos, qvel, sensors[:, -1], inputs, self._target, self._last_action)
-        frame = {k: torch.nan_to_num(v, nan=0.0, posinf=0.0, neginf=0.0) for k, v in frame.items()}
         self._stack.push(frame)
         obs = self._stack.observation()
 
@@ -238,9 +238,14 @@ class RotoEnv:
             raise TypeError(f"action dtype {action.dtype} is not floating point; use torch.float32 or torch.float64")
         if action.device != self.device:
             raise ValueError(f"action is on device {action.device}; this env runs on {self.device}")
-        if not bool(torch.isfinite(action).all()):
+        # one reduction instead of an element-wise check: a NaN or inf anywhere makes the sum
+        # non-finite; a sum that overflowed from finite values is told apart by the full check
+        if not math.isfinite(float(action.sum())):
             bad = torch.nonzero(~torch.isfinite(action).all(dim=1)).flatten().tolist()
-            raise ValueError(f"action has non-finite values (NaN or inf) in envs {bad[:10]}; actions must be finite")
+            if bad:
+                raise ValueError(
+                    f"action has non-finite values (NaN or inf) in envs {bad[:10]}; actions must be finite"
+                )
         return action
 
     def _task_inputs(self, qpos: torch.Tensor, qvel: torch.Tensor, sensors: torch.Tensor) -> TaskInputs:
@@ -260,7 +265,8 @@ class RotoEnv:
         target: torch.Tensor,
         last_action: torch.Tensor,
     ) -> dict[str, torch.Tensor]:
-        """One observation frame per group from (n, ·) state tensors."""
+        """One observation frame per group from (n, ·) state tensors; NaN and inf read as 0 (a
+        diverged world's last frame), the tactile bits are finite by construction."""
         idx = self._idx
         groups: dict[str, torch.Tensor] = {}
         if "tactile" in self.groups:
@@ -273,9 +279,11 @@ class RotoEnv:
             target,
             idx.act_qpos.take(qpos),
             last_action,
-        )
+        ).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0)
         if "privileged" in self.groups:
-            groups["privileged"] = privileged_frame(inputs.ball_pos, inputs.ball_vel)
+            groups["privileged"] = privileged_frame(inputs.ball_pos, inputs.ball_vel).nan_to_num_(
+                nan=0.0, posinf=0.0, neginf=0.0
+            )
         return {name: groups[name] for name in self.groups}
 
     def _reset_worlds(self, env_ids: torch.Tensor) -> dict[str, torch.Tensor]:
@@ -289,18 +297,17 @@ class RotoEnv:
             qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
         )
         ball_pos = self.task.reset(self.task_state, env_ids, self._generator)
-        idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))
-        idx.ball_quat.put(qpos, idx.identity_quat)
+        idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))  # the default pose holds the balls' identity quaternions
         qvel = torch.zeros(n, self.model.nv, dtype=torch.float64, device=self.device)
         target = idx.act_qpos.take(qpos).clone()
         sensors = self.backend.set_state(env_ids, qpos, qvel, target).to(self.device, torch.float64)
 
         self._target[env_ids] = target
-        self._last_action[env_ids] = 0.0
-        self._episode.length[env_ids] = 0
-        self._episode.ret[env_ids] = 0.0
+        self._last_action.index_fill_(0, env_ids, 0.0)
+        self._episode.length.index_fill_(0, env_ids, 0)
+        self._episode.ret.index_fill_(0, env_ids, 0.0)
         for value in self._term_sums.values():
-            value[env_ids] = 0.0
+            value.index_fill_(0, env_ids, 0.0)
         inputs = TaskInputs(
             ball_pos=idx.ball_pos.take(qpos), ball_vel=idx.ball_vel.take(qvel), ball_contact=torch.zeros(0)
         )
@@ -308,12 +315,12 @@ class RotoEnv:
 
     def _episode_info(self, truncated: torch.Tensor) -> dict[str, torch.Tensor]:
         info = {
-            "r": self._episode.ret.to(torch.float32).clone(),
+            "r": self._episode.ret.to(torch.float32, copy=True),
             "l": self._episode.length.clone(),
             "time_out": truncated.clone(),
         }
         info.update({k: v.clone() for k, v in self.task.metrics(self.task_state).items()})
-        info.update({f"reward/{k}": v.to(torch.float32).clone() for k, v in self._term_sums.items()})
+        info.update({f"reward/{k}": v.to(torch.float32, copy=True) for k, v in self._term_sums.items()})
         return info
 
 
@@ -329,12 +336,10 @@ class _Indices:
     ctrl_lo: torch.Tensor
     ctrl_hi: torch.Tensor
     ball_pos: Columns  # (n_ball, 3) qpos indices of each ball's centre
-    ball_quat: Columns  # (n_ball, 4)
     ball_vel: Columns  # (n_ball, 3) qvel indices of each ball's linear velocity
     tactile_force: Columns  # (n_links,) sensordata index of each link's normal force
     ball_force: Columns  # (n_ball,) sensordata index of each ball-hand normal force
-    default_qpos: torch.Tensor  # (1, nq)
-    identity_quat: torch.Tensor  # (4,)
+    default_qpos: torch.Tensor  # (1, nq), the balls' quaternions at identity
     coupled_driven: Columns
     coupled_driver: Columns
     coupled_ratio: torch.Tensor
@@ -354,6 +359,7 @@ class _Indices:
         driver = [model.joint(d).qposadr[0] for d, _ in robot.coupled_joints.values()]
         driven_ids = [model.joint(j).id for j in robot.coupled_joints]
         default = layout.default_qpos.copy()
+        default[layout.ball_qpos[:, None] + 3 + np.arange(4)] = [1.0, 0.0, 0.0, 0.0]  # every reset starts unrotated
         for j, (d, ratio) in robot.coupled_joints.items():
             default[model.joint(j).qposadr[0]] = np.clip(
                 ratio * default[model.joint(d).qposadr[0]], *model.jnt_range[model.joint(j).id]
@@ -367,12 +373,10 @@ class _Indices:
             ctrl_lo=t(layout.ctrl_lo, f64),
             ctrl_hi=t(layout.ctrl_hi, f64),
             ball_pos=c(layout.ball_qpos[:, None] + np.arange(3)),
-            ball_quat=c(layout.ball_qpos[:, None] + 3 + np.arange(4)),
             ball_vel=c(layout.ball_qvel[:, None] + np.arange(3)),
             tactile_force=c(layout.tactile_sensor + 1),
             ball_force=c(layout.ball_contact_sensor + 1),
             default_qpos=t(default, f64)[None],
-            identity_quat=t([1.0, 0.0, 0.0, 0.0], f64),
             coupled_driven=c(driven),
             coupled_driver=c(driver),
             coupled_ratio=t([r for _, r in robot.coupled_joints.values()], f64),

@@ -115,9 +115,8 @@ class Baoding:
         Ball a starts on T_b and ball b on T_a (plus one shared U(±5 mm)³ offset): started on their
         own targets, both would latch at once and the first swap would be free.
         """
-        state.swapped[env_ids] = False
-        state.latched[env_ids] = False
-        state.swaps[env_ids] = 0
+        for latch in (state.swapped, state.latched, state.swaps):
+            latch.index_fill_(0, env_ids, 0)
         offset = uniform(generator, (len(env_ids), 1, 3), RESET_NOISE, state.targets.device)
         return state.targets.flip(0)[None] + offset
 
@@ -125,7 +124,7 @@ class Baoding:
         """Latch, swap (+10), dense shaping; end when the balls part or drop."""
         pos = inputs.ball_pos
         dist, swap, state.swapped, state.latched = baoding_rule(pos, state.targets, state.swapped, state.latched)
-        state.swaps += swap.long()
+        state.swaps += swap
         dense = DENSE_SCALE * (1.0 - torch.tanh(dist / DENSE_LENGTH)).sum(dim=1)
         separation = torch.linalg.vector_norm(pos[:, 0] - pos[:, 1], dim=-1)
         dropped = (pos[:, :, 2] < -PALM_DROP_LIMIT).any(dim=1)

@@ -53,7 +53,7 @@ def bounce_counter(
     valid = new_contact & (steps_without_contact >= min_flight_steps)
     bounce = waiting & valid
     waiting = (waiting | lost_contact) & ~bounce
-    steps_without_contact = torch.where(contact, torch.zeros_like(steps_without_contact), steps_without_contact + 1)
+    steps_without_contact = (steps_without_contact + 1).masked_fill_(contact, 0)
     return bounce, waiting, steps_without_contact
 
 
@@ -76,10 +76,8 @@ class Bounce:
 
     def reset(self, state: BounceState, env_ids: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
         """Clear counters; ball ~10 cm above the palm centre plus U(±1 cm) per axis."""
-        state.prev_contact[env_ids] = False
-        state.waiting[env_ids] = False
-        state.steps_without_contact[env_ids] = 0
-        state.bounces[env_ids] = 0
+        for counter in (state.prev_contact, state.waiting, state.steps_without_contact, state.bounces):
+            counter.index_fill_(0, env_ids, 0)
         device = state.bounces.device
         pos = uniform(generator, (len(env_ids), 1, 3), SPAWN_NOISE, device)
         pos[..., 2] += SPAWN_HEIGHT
@@ -92,7 +90,7 @@ class Bounce:
             contact, state.prev_contact, state.waiting, state.steps_without_contact
         )
         state.prev_contact = contact
-        state.bounces += bounce.long()
+        state.bounces += bounce
         pos = inputs.ball_pos[:, 0]
         terminated = (pos[:, 2] < -PALM_DROP_LIMIT) | (torch.linalg.vector_norm(pos[:, :2], dim=-1) > HORIZONTAL_LIMIT)
         return StepResult(reward_terms={"bounce": BOUNCE_REWARD * bounce.to(pos.dtype)}, terminated=terminated)
