@@ -23,6 +23,7 @@ from roto.envs.columns import Columns
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
 from roto.envs.observations import OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
+from roto.envs.start_pool import StartPool
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
 from roto.sim.backend import make_backend
@@ -84,6 +85,8 @@ class RotoEnv:
         )
         self._target = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
         self._last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
+        self._zero_qvel = torch.zeros(self.num_envs, self.model.nv, dtype=torch.float64, device=self.device)
+        self._starts = StartPool(self._draw_starts, size=self.num_envs)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
         self._needs_reset = True
@@ -102,6 +105,7 @@ class RotoEnv:
         """Reset every world; returns (obs, info). ``seed`` re-seeds the reset noise."""
         if seed is not None:
             self._generator.manual_seed(int(seed))
+        self._starts.clear()  # a reset, seeded or not, starts from freshly drawn starts
         all_ids = torch.arange(self.num_envs, device=self.device)
         frame = self._reset_worlds(all_ids)
         self._stack.reset(frame)
@@ -166,7 +170,7 @@ class RotoEnv:
         self.backend.close()
 
     def state_dict(self) -> dict[str, Any]:
-        """Everything that decides the env's future: physics, task counters, frame stack, RNG.
+        """Everything that decides the env's future: physics, task counters, frame stack, RNG, pooled starts.
 
         ``load_state_dict`` of it on an env built from the same config continues bit-identically
         (what exact training resume relies on).
@@ -181,6 +185,7 @@ class RotoEnv:
             "target": self._target.clone(),
             "last_action": self._last_action.clone(),
             "generator": self._generator.get_state(),
+            "starts": self._starts.state_dict(),
             "nonfinite_resets": self.nonfinite_resets,
             "needs_reset": self._needs_reset,
         }
@@ -197,6 +202,10 @@ class RotoEnv:
         self._target = state["target"].clone().to(self.device)
         self._last_action = state["last_action"].clone().to(self.device)
         self._generator.set_state(state["generator"].cpu())
+        if "starts" in state:
+            self._starts.load_state_dict(state["starts"], self.device)
+        else:  # saved before episode starts were pooled: draw afresh
+            self._starts.clear()
         self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
 
@@ -287,8 +296,21 @@ class RotoEnv:
         return {name: groups[name] for name in self.groups}
 
     def _reset_worlds(self, env_ids: torch.Tensor) -> dict[str, torch.Tensor]:
-        """Reset worlds ``env_ids``: hand at default pose + noise, task objects placed; their first frame."""
-        n = len(env_ids)
+        """Start new episodes in worlds ``env_ids`` from the next pooled starts; their first frame."""
+        start = self._starts.take(len(env_ids))
+        self.backend.set_state(env_ids, start["qpos"], self._zero_qvel[: len(env_ids)])
+        self.task.reset(self.task_state, env_ids)
+        self._target[env_ids] = start["target"]
+        self._last_action.index_fill_(0, env_ids, 0.0)
+        self._episode.length.index_fill_(0, env_ids, 0)
+        self._episode.ret.index_fill_(0, env_ids, 0.0)
+        for value in self._term_sums.values():
+            value.index_fill_(0, env_ids, 0.0)
+        return {name: start[f"frame/{name}"] for name in self.groups}
+
+    def _draw_starts(self, n: int) -> dict[str, torch.Tensor]:
+        """n episode starts: hand at the default pose + noise, the task's balls placed, zero velocity;
+        their qpos (n, nq), joint targets (n, n_act) and first frame ("frame/<group>", (n, dim))."""
         idx = self._idx
         qpos = idx.default_qpos.expand(n, -1).clone()
         noise = uniform(self._generator, (n, self.num_actions), self.config.reset_joint_noise, self.device)
@@ -296,22 +318,17 @@ class RotoEnv:
         idx.coupled_driven.put(
             qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
         )
-        ball_pos = self.task.reset(self.task_state, env_ids, self._generator)
+        ball_pos = self.task.initial_ball_positions(self.task_state, n, self._generator)
         idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))  # the default pose holds the balls' identity quaternions
-        qvel = torch.zeros(n, self.model.nv, dtype=torch.float64, device=self.device)
+        qvel = self._zero_qvel[:n] if n <= self.num_envs else qpos.new_zeros(n, self.model.nv)
         target = idx.act_qpos.take(qpos).clone()
-        sensors = self.backend.set_state(env_ids, qpos, qvel, target).to(self.device, torch.float64)
-
-        self._target[env_ids] = target
-        self._last_action.index_fill_(0, env_ids, 0.0)
-        self._episode.length.index_fill_(0, env_ids, 0)
-        self._episode.ret.index_fill_(0, env_ids, 0.0)
-        for value in self._term_sums.values():
-            value.index_fill_(0, env_ids, 0.0)
+        sensors = self.backend.sensors_at(qpos, qvel, target).to(self.device, torch.float64)
         inputs = TaskInputs(
             ball_pos=idx.ball_pos.take(qpos), ball_vel=idx.ball_vel.take(qvel), ball_contact=torch.zeros(0)
         )
-        return self._frame(qpos, qvel, sensors, inputs, target, self._last_action[env_ids])
+        last_action = torch.zeros(n, self.num_actions, dtype=torch.float32, device=self.device)
+        frame = self._frame(qpos, qvel, sensors, inputs, target, last_action)
+        return {"qpos": qpos, "target": target, **{f"frame/{name}": value for name, value in frame.items()}}
 
     def _episode_info(self, truncated: torch.Tensor) -> dict[str, torch.Tensor]:
         info = {

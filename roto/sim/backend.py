@@ -40,10 +40,13 @@ class Backend(Protocol):
         """Hold ``ctrl`` (B, nu) for ``substeps`` physics steps on every world."""
         ...
 
-    def set_state(
-        self, world_ids: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor
-    ) -> torch.Tensor:
-        """Overwrite the given worlds' state; return their sensordata (len(ids), nsensordata) at it."""
+    def set_state(self, world_ids: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor) -> None:
+        """Overwrite the given worlds' state (n,) with ``qpos`` (n, nq), ``qvel`` (n, nv), time 0."""
+        ...
+
+    def sensors_at(self, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor) -> torch.Tensor:
+        """Sensordata (n, nsensordata) at the states ``qpos`` (n, nq), ``qvel`` (n, nv) under ``ctrl``
+        (n, nu), evaluated as a step from them would; no world changes."""
         ...
 
     def physics_state(self) -> np.ndarray:

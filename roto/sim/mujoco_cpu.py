@@ -18,9 +18,9 @@ from roto.sim.backend import SimState
 from roto.sim.rollout_threads import RolloutThreads
 
 _FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
-_SERIAL_RESET_WORLDS = 32
-"""Resets of fewer worlds run their one sensor step on the calling thread alone: for the handful of
-worlds a step resets, waking a helper costs more than it saves (benchmarks/README.md)."""
+_SERIAL_SENSOR_STATES = 32
+"""Fewer states than this get their one sensor step on the calling thread alone: for a handful of
+states, waking a helper costs more than it saves (benchmarks/README.md)."""
 
 
 def state_offsets(model: mujoco.MjModel) -> tuple[int, int]:
@@ -46,8 +46,9 @@ class MujocoCpuBackend:
         self._qpos0, self._qvel0 = state_offsets(model)
         self.state = np.zeros((num_worlds, self._nstate))
         data = mujoco.MjData(model)
-        mujoco.mj_getState(model, data, self.state[0], _FULL)
-        self.state[:] = self.state[0]
+        self._initial_state = np.zeros(self._nstate)  # the model's reference state, time 0
+        mujoco.mj_getState(model, data, self._initial_state, _FULL)
+        self.state[:] = self._initial_state
         self._ctrl = np.zeros((num_worlds, substeps, model.nu))
         self._out_state = np.zeros((num_worlds, substeps, self._nstate))
         self._out_sensor = np.zeros((num_worlds, substeps, model.nsensordata))
@@ -78,29 +79,32 @@ class MujocoCpuBackend:
             diverged=torch.from_numpy(diverged),
         )
 
-    def set_state(
-        self, world_ids: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor
-    ) -> torch.Tensor:
-        """Overwrite worlds ``world_ids`` (n,) with ``qpos`` (n, nq), ``qvel`` (n, nv), time 0.
-
-        Returns their sensordata (n, nsensordata) evaluated at the new state under ``ctrl`` (n, nu)
-        (one throw-away physics step computes it; its resulting state is discarded).
-        """
+    def set_state(self, world_ids: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor) -> None:
+        """Overwrite worlds ``world_ids`` (n,) with ``qpos`` (n, nq), ``qvel`` (n, nv), time 0."""
         ids = world_ids.cpu().numpy()
         self.state[ids, 0] = 0.0
         self.state[ids, self._qpos0 : self._qpos0 + self.model.nq] = qpos.cpu().to(torch.float64).numpy()
         self.state[ids, self._qvel0 : self._qvel0 + self.model.nv] = qvel.cpu().to(torch.float64).numpy()
-        n = len(ids)
-        if n == 0:
-            return torch.zeros((0, self.model.nsensordata), dtype=torch.float64)
+
+    def sensors_at(self, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor) -> torch.Tensor:
+        """Sensordata (n, nsensordata) at the states ``qpos`` (n, nq), ``qvel`` (n, nv) under ``ctrl``
+        (n, nu); no world changes.
+
+        One throw-away physics step from each state computes them (sensors are evaluated on the
+        state a step starts from); its resulting state is discarded.
+        """
+        n = len(qpos)
+        state0 = np.repeat(self._initial_state[None], n, axis=0)
+        state0[:, self._qpos0 : self._qpos0 + self.model.nq] = qpos.cpu().to(torch.float64).numpy()
+        state0[:, self._qvel0 : self._qvel0 + self.model.nv] = qvel.cpu().to(torch.float64).numpy()
         sensors = np.zeros((n, 1, self.model.nsensordata))
         self._pool.run(
-            np.ascontiguousarray(self.state[ids]),
+            state0,
             np.ascontiguousarray(ctrl.cpu().to(torch.float64).numpy()[:, None, :]),
             np.zeros((n, 1, self._nstate)),
             sensors,
             nstep=1,
-            threads=1 if n < _SERIAL_RESET_WORLDS else None,
+            threads=1 if n < _SERIAL_SENSOR_STATES else None,
         )
         return torch.from_numpy(sensors[:, 0])
 

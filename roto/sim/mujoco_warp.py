@@ -208,24 +208,42 @@ class MujocoWarpBackend:
         diverged = ~((self._qpos.abs() <= MAX_VALUE).all(dim=1) & (self._qvel.abs() <= MAX_VALUE).all(dim=1))
         return SimState(qpos=self._qpos, qvel=self._qvel, sensordata=self._sensors, diverged=diverged)
 
-    def set_state(
-        self, world_ids: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor
-    ) -> torch.Tensor:
-        """Overwrite worlds ``world_ids`` (n,) with ``qpos`` (n, nq), ``qvel`` (n, nv), time 0.
-
-        Returns their sensordata (n, nsensordata) at the new state under ``ctrl`` (n, nu), computed
-        by one ``forward`` of every world (forward changes no state, so the others are unaffected).
-        """
+    def set_state(self, world_ids: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor) -> None:
+        """Overwrite worlds ``world_ids`` (n,) with ``qpos`` (n, nq), ``qvel`` (n, nv), time 0."""
         ids = world_ids.to(self.device)
         if len(ids) == 0:
-            return torch.zeros((0, self.model.nsensordata), dtype=torch.float32, device=self.device)
+            return
         self._time[ids] = 0.0
         self._qpos[ids] = qpos.to(self.device, torch.float32)
         self._qvel[ids] = qvel.to(self.device, torch.float32)
         self._act[ids] = 0.0
-        self._ctrl[ids] = ctrl.to(self.device, torch.float32)
-        self._run(self._forward_graph, self._forward_sequence)
-        return self._sensordata[ids]  # indexing by a tensor copies
+
+    def sensors_at(self, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor) -> torch.Tensor:
+        """Sensordata (n, nsensordata) at the states ``qpos`` (n, nq), ``qvel`` (n, nv) under ``ctrl``
+        (n, nu); no world changes.
+
+        Up to B states at a time are written into the first worlds, whose state is kept aside, and
+        one ``forward`` of every world (the captured graph on a GPU) evaluates the sensors; then the
+        kept state goes back (forward changes no state, so the other worlds are unaffected).
+        """
+        parts = (self._time, self._qpos, self._qvel, self._act, self._ctrl)
+        chunks = []
+        for first in range(0, len(qpos), self.num_worlds):
+            rows = slice(0, min(self.num_worlds, len(qpos) - first))
+            kept = [part[rows].clone() for part in parts]
+            chunk = slice(first, first + rows.stop)
+            self._time[rows] = 0.0
+            self._qpos[rows] = qpos[chunk].to(self.device, torch.float32)
+            self._qvel[rows] = qvel[chunk].to(self.device, torch.float32)
+            self._act[rows] = 0.0
+            self._ctrl[rows] = ctrl[chunk].to(self.device, torch.float32)
+            self._run(self._forward_graph, self._forward_sequence)
+            chunks.append(self._sensordata[rows].clone())
+            for part, value in zip(parts, kept, strict=True):
+                part[rows] = value
+        if not chunks:
+            return torch.zeros((0, self.model.nsensordata), dtype=torch.float32, device=self.device)
+        return torch.cat(chunks)
 
     def physics_state(self) -> np.ndarray:
         """(B, nstate) float64 host copy of every world's ``mjSTATE_FULLPHYSICS`` state."""

@@ -109,15 +109,17 @@ class Baoding:
             swaps=torch.zeros(num_envs, dtype=torch.int64, device=device),
         )
 
-    def reset(self, state: BaodingState, env_ids: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
-        """Clear latches and assignment (ball a -> T_a, ball b -> T_b); place the balls.
-
-        Ball a starts on T_b and ball b on T_a (plus one shared U(±5 mm)³ offset): started on their
-        own targets, both would latch at once and the first swap would be free.
-        """
+    def reset(self, state: BaodingState, env_ids: torch.Tensor) -> None:
+        """Clear the latches, swap count and assignment (ball a -> T_a, ball b -> T_b) of ``env_ids``."""
         for latch in (state.swapped, state.latched, state.swaps):
             latch.index_fill_(0, env_ids, 0)
-        offset = uniform(generator, (len(env_ids), 1, 3), RESET_NOISE, state.targets.device)
+
+    def initial_ball_positions(self, state: BaodingState, n: int, generator: torch.Generator) -> torch.Tensor:
+        """(n, 2, 3): ball a on T_b and ball b on T_a, plus one shared U(±5 mm)³ offset.
+
+        Started on their own targets, both balls would latch at once and the first swap would be free.
+        """
+        offset = uniform(generator, (n, 1, 3), RESET_NOISE, state.targets.device)
         return state.targets.flip(0)[None] + offset
 
     def step(self, state: BaodingState, inputs: TaskInputs) -> StepResult:

@@ -61,8 +61,12 @@ class Task(Protocol):
         """Fresh per-env task state (counters, latches)."""
         ...
 
-    def reset(self, state: object, env_ids: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
-        """Clear the task state of ``env_ids`` (n,); return their initial ball positions (n, n_ball, 3)."""
+    def reset(self, state: object, env_ids: torch.Tensor) -> None:
+        """Clear the task state of ``env_ids`` (n,) for a new episode."""
+        ...
+
+    def initial_ball_positions(self, state: object, n: int, generator: torch.Generator) -> torch.Tensor:
+        """Ball positions (n, n_ball, 3) that start n new episodes, drawn from ``generator``."""
         ...
 
     def step(self, state: object, inputs: TaskInputs) -> StepResult:

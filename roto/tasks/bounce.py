@@ -74,12 +74,14 @@ class Bounce:
         zeros_i = torch.zeros(num_envs, dtype=torch.int64, device=device)
         return BounceState(zeros_b, zeros_b.clone(), zeros_i, zeros_i.clone())
 
-    def reset(self, state: BounceState, env_ids: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
-        """Clear counters; ball ~10 cm above the palm centre plus U(±1 cm) per axis."""
+    def reset(self, state: BounceState, env_ids: torch.Tensor) -> None:
+        """Clear the counters of ``env_ids``."""
         for counter in (state.prev_contact, state.waiting, state.steps_without_contact, state.bounces):
             counter.index_fill_(0, env_ids, 0)
-        device = state.bounces.device
-        pos = uniform(generator, (len(env_ids), 1, 3), SPAWN_NOISE, device)
+
+    def initial_ball_positions(self, state: BounceState, n: int, generator: torch.Generator) -> torch.Tensor:
+        """(n, 1, 3): the ball ~10 cm above the palm centre plus U(±1 cm) per axis."""
+        pos = uniform(generator, (n, 1, 3), SPAWN_NOISE, state.bounces.device)
         pos[..., 2] += SPAWN_HEIGHT
         return pos
 

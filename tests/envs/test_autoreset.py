@@ -24,7 +24,7 @@ def test_episode_info_and_final_obs_on_termination():
     state = env.backend.state
     qpos = torch.from_numpy(env.backend.qpos.copy())
     qpos[:, env._idx.ball_pos.index[0, 2]] = -0.5
-    env.backend.set_state(torch.arange(3), qpos, torch.zeros(3, env.model.nv), torch.zeros(3, 20))
+    env.backend.set_state(torch.arange(3), qpos, torch.zeros(3, env.model.nv))
     obs, _, terminated, truncated, info = env.step(torch.zeros(3, 20))
     assert terminated.all() and not truncated.any()
     assert info["_episode"].all() and torch.equal(info["episode"]["l"], torch.ones(3, dtype=torch.int64))
@@ -43,7 +43,7 @@ def test_non_finite_world_is_reset_and_counted_others_untouched():
     qvel = torch.from_numpy(env.backend.qvel.copy())
     qvel[1, 0] = float("nan")
     qpos = torch.from_numpy(env.backend.qpos.copy())
-    env.backend.set_state(torch.tensor([1]), qpos[1:2], qvel[1:2], env._target[1:2])
+    env.backend.set_state(torch.tensor([1]), qpos[1:2], qvel[1:2])
     reference = make_env("bounce", num_envs=3)
     reference.reset()
     for _ in range(3):

@@ -98,13 +98,33 @@ def test_ball_on_palm_gives_identical_bits_on_both_backends(name):
     ]
     force = layout.tactile_sensor + 1
     for backend in backends:
-        backend.set_state(torch.tensor([0]), qpos, torch.zeros(1, model.nv), ctrl)
+        backend.set_state(torch.tensor([0]), qpos, torch.zeros(1, model.nv))
     lit = 0
     for _ in range(20):
         bits = [(b.step(ctrl).sensordata[0, :, force] > 0.01).clone() for b in backends]
         assert torch.equal(bits[0], bits[1])
         lit += int(bits[0].sum())
     assert lit > 0  # the ball did land
+
+
+def test_sensors_at_more_states_than_worlds_match_the_cpu_backend_and_change_no_world():
+    envs = [roto.make("baoding", robot="allegro", num_envs=2, seed=0, backend=b) for b in ("cpu", "warp")]
+    for env in envs:
+        env.reset()
+        for _ in range(5):
+            env.step(env.hold_action().expand(2, -1))
+    starts = envs[0]._draw_starts(5)  # 5 states on 2 worlds: chunks of 2, 2 and 1 on Warp
+    qpos, target = starts["qpos"], starts["target"]
+    qvel = torch.zeros(5, envs[0].model.nv, dtype=torch.float64)
+    before = physics(envs[1])
+    sensors = [env.backend.sensors_at(qpos, qvel, target).to(torch.float64) for env in envs]
+    assert torch.equal(physics(envs[1]), before)
+    force = torch.from_numpy(envs[0].layout.tactile_sensor + 1)
+    bits = [s[:, force] > envs[0].config.tactile_threshold for s in sensors]
+    assert torch.equal(bits[0], bits[1]) and bits[0].any()  # the balls rest on the hand
+    assert torch.equal(sensors[0], envs[0].backend.sensors_at(qpos, qvel, target))  # CPU: no world state used
+    for env in envs:
+        env.close()
 
 
 @pytest.mark.parametrize("name", ["allegro", "shadow"])
@@ -123,7 +143,7 @@ def test_held_baoding_balls_and_their_lift_read_the_same_on_both_backends(name):
     for env in envs:  # lift both balls 30 cm: every bit clears within one step on both
         qpos = physics(env)[:, 1 : 1 + env.model.nq]
         qpos[0, idx.ball_pos.index[:, 2]] = 0.3
-        env.backend.set_state(torch.tensor([0]), qpos, torch.zeros(1, env.model.nv), env._target)
+        env.backend.set_state(torch.tensor([0]), qpos, torch.zeros(1, env.model.nv))
         assert env.step(hold)[0]["tactile"][0, -n_links:].sum() == 0
 
 
@@ -150,7 +170,7 @@ def test_a_diverged_world_is_reset_and_the_others_are_untouched():
     poisoned = envs[1]
     qpos = physics(poisoned)[1:2, 1 : 1 + poisoned.model.nq]
     qvel = torch.full((1, poisoned.model.nv), 1e12)  # beyond mjMAXVAL
-    poisoned.backend.set_state(torch.tensor([1]), qpos, qvel, poisoned._target[1:2])
+    poisoned.backend.set_state(torch.tensor([1]), qpos, qvel)
     out_clean = envs[0].step(actions[4])
     out_poisoned = poisoned.step(actions[4])
     info = out_poisoned[4]
