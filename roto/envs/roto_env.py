@@ -320,7 +320,7 @@ class RotoEnv:
         )
         ball_pos = self.task.initial_ball_positions(self.task_state, n, self._generator)
         idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))  # the default pose holds the balls' identity quaternions
-        qvel = self._zero_qvel[:n] if n <= self.num_envs else qpos.new_zeros(n, self.model.nv)
+        qvel = qpos.new_zeros(n, self.model.nv)
         target = idx.act_qpos.take(qpos).clone()
         sensors = self.backend.sensors_at(qpos, qvel, target).to(self.device, torch.float64)
         inputs = TaskInputs(

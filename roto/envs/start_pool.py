@@ -54,11 +54,11 @@ class StartPool:
         """Drop every start drawn so far."""
         self._rows, self._next = {}, 0
 
-    def state_dict(self) -> dict[str, Starts | int]:
+    def state_dict(self) -> dict[str, Starts]:
         """Copies of the starts not yet handed out."""
-        return {"rows": {name: rows[self._next :].clone() for name, rows in self._rows.items()}, "next": 0}
+        return {"rows": {name: rows[self._next :].clone() for name, rows in self._rows.items()}}
 
-    def load_state_dict(self, state: dict[str, Starts | int], device: torch.device) -> None:
+    def load_state_dict(self, state: dict[str, Starts], device: torch.device) -> None:
         """Restore what ``state_dict`` returned."""
         self._rows = {name: rows.clone().to(device) for name, rows in state["rows"].items()}
-        self._next = int(state["next"])
+        self._next = 0
