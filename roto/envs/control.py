@@ -1,4 +1,4 @@
-"""Action -> joint targets (SPEC §2), as pure functions."""
+"""Action -> joint targets (docs/spec.md §2), as pure functions."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Allegro Hand (16 joints, all actuated): roto's own model, built with MjSpec from public facts.
 
-No clean PyPI package carries an Allegro model (ASSETS.md), so roto builds one from the published
+No clean PyPI package carries an Allegro model, so roto builds one from the published
 kinematics and collision primitives of the Wonik Allegro Hand v4 (right): link lengths, joint axes
 and ranges, link masses and the box/capsule collision set (sources in docs/robots.md). Collision
 only, no meshes: every link is drawn by its collision primitive.

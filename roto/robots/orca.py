@@ -3,7 +3,7 @@
 ``orca-sim`` ships the right hand as ``scene_right.xml`` (options, classes and meshes included); it
 is read by path from the installed package and edited with MjSpec: the floor is dropped and each
 convex collision mesh is replaced by the box that bounds it (its axis-aligned box in the mesh
-frame), which MuJoCo collides faster (ASSETS.md). Visual meshes stay for rendering.
+frame), which MuJoCo collides faster. Visual meshes stay for rendering.
 """
 
 from __future__ import annotations
@@ -87,7 +87,7 @@ ORCA = RobotSpec(
         *(_j(f"{f}_{link}") for f in _FINGERS for link in ("mp", "pp", "ip")),
         *(_j(f"thumb_{link}") for link in ("mp", "pp", "ip", "dp")),
     ),
-    # SPEC §2 (roto's ORCA drive): wrist kp 100 kd 10; abduction / MCP kp 2 kd 0.1; PIP / DIP kp 4 kd 0.2.
+    # docs/spec.md §2 (roto's ORCA drive): wrist kp 100 kd 10; abduction / MCP kp 2 kd 0.1; PIP / DIP kp 4 kd 0.2.
     gains={
         "wrist": Gains(kp=100.0, kv=10.0),
         "pip": Gains(kp=4.0, kv=0.2),

@@ -62,7 +62,7 @@ SHADOW = RobotSpec(
     load_spec=load_shadow_spec,
     root_body="robot0:hand mount",
     actuated_joints=_ACTUATED,
-    observed_joints=_ACTUATED,  # SPEC §3: Shadow's pos/vel cover its 20 actuated joints
+    observed_joints=_ACTUATED,  # docs/spec.md §3: Shadow's pos/vel cover its 20 actuated joints
     tactile_links=tuple(_j(f"{f}distal") for f in _FINGERS)
     + tuple(_j(f"{f}middle") for f in _FINGERS)
     + tuple(_j(f"{f}proximal") for f in _FINGERS)

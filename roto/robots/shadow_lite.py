@@ -1,7 +1,7 @@
 """Shadow Hand Lite (16 joints, 13 actuators), derived from the gymnasium-robotics Shadow with MjSpec.
 
 No Lite model ships on PyPI, so roto cuts the full Shadow down the way the real Lite differs from
-it (ASSETS.md, "Gaps"): no little finger, no wrist joints (the wrist is fixed, bent back 40° as on
+it (docs/robots.md): no little finger, no wrist joints (the wrist is fixed, bent back 40° as on
 the real Lite), and no THJ2 (the Lite's thumb has no Shadow THJ3). Each finger's distal joint is
 tied 1:1 to its middle joint (the Lite's mimic joint), by re-weighting the model's coupling tendon.
 Joint names keep the gym convention (J0 distal, J3 abduction).
@@ -97,7 +97,7 @@ SHADOW_LITE = RobotSpec(
     load_spec=load_shadow_lite_spec,
     root_body="robot0:hand mount",
     actuated_joints=_ACTUATED,
-    observed_joints=_OBSERVED,  # SPEC §3: the Lite's pos/vel cover all 16 joints
+    observed_joints=_OBSERVED,  # docs/spec.md §3: the Lite's pos/vel cover all 16 joints
     tactile_links=tuple(_j(f"{f}distal") for f in (*_FINGERS, "th"))
     + tuple(_j(f"{f}middle") for f in (*_FINGERS, "th"))
     + tuple(_j(f"{f}proximal") for f in (*_FINGERS, "th"))

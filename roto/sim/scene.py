@@ -19,7 +19,7 @@ from roto.robots.mjspec_tools import build_hand
 from roto.robots.spec import RobotSpec
 
 PHYSICS_DT = 1.0 / 240.0
-"""Physics timestep (s), SPEC §1."""
+"""Physics timestep (s), docs/spec.md §1."""
 
 _FOUND, _FORCE = 1, 2
 _REDUCE_MAXFORCE = 2

@@ -1,4 +1,4 @@
-"""Baoding: rotate two balls around each other in the hand as often as possible in 10 s (SPEC §6)."""
+"""Baoding: rotate two balls around each other in the hand as often as possible in 10 s (docs/spec.md §6)."""
 
 from __future__ import annotations
 

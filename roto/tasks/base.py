@@ -15,7 +15,7 @@ from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec
 
 PALM_DROP_LIMIT = 0.2
-"""A ball more than this far below the palm centre (m) ends the episode (SPEC §5, §6)."""
+"""A ball more than this far below the palm centre (m) ends the episode (docs/spec.md §5, §6)."""
 
 
 @dataclass(frozen=True)

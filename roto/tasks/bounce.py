@@ -1,4 +1,4 @@
-"""Bounce: bounce a 70 mm ball on the palm as often as possible in 10 s (SPEC §5)."""
+"""Bounce: bounce a 70 mm ball on the palm as often as possible in 10 s (docs/spec.md §5)."""
 
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ import torch
 from roto.registry import list_envs
 from tests.conftest import make_env
 
-# SPEC §3 per robot: tactile links, proprio = 2 * observed joints + 2 * actions, actions
+# docs/spec.md §3 per robot: tactile links, proprio = 2 * observed joints + 2 * actions, actions
 TABLE = {"shadow": (17, 80, 20), "shadow_lite": (14, 58, 13), "allegro": (20, 64, 16), "orca": (17, 68, 17)}
 
 

@@ -1,4 +1,4 @@
-"""Every registered hand against SPEC §3's table, and the checks each hand must pass."""
+"""Every registered hand against docs/spec.md §3's table, and the checks each hand must pass."""
 
 import mujoco
 import numpy as np
@@ -10,7 +10,7 @@ from roto.robots.mjspec_tools import palm_frame, tilt_rotation
 from roto.sim.scene import build_scene
 from roto.tasks.baoding import calibrate_targets
 
-# SPEC §3: hand joints, actions, tactile links, blind frame size
+# docs/spec.md §3: hand joints, actions, tactile links, blind frame size
 TABLE = {
     "shadow": (24, 20, 17, 97),
     "shadow_lite": (16, 13, 14, 72),
