@@ -50,8 +50,9 @@ def test_train_writes_config_checkpoints_csv_and_events(trained_run, capsys):
     ckpts = trained_run / "checkpoints"
     assert (ckpts / "latest.pt").is_file() and (ckpts / "agent_3.pt").is_file()
     csv_text = (trained_run / "scalars.csv").read_text()
-    for tag in ("ppo/approx_kl", "ppo/clip_fraction", "ppo/explained_variance", "ppo/entropy", "ppo/action_std",
-                "ppo/lr", "perf/simulation_s", "perf/inference_s", "perf/update_s"):  # fmt: skip
+    for tag in ("ppo/approx_kl", "ppo/clip_fraction", "ppo/explained_variance", "loss/entropy", "ppo/action_std",
+                "ppo/lr", "loss/surrogate", "loss/value", "loss/total", "perf/simulation_s", "perf/inference_s",
+                "perf/update_s", "perf/eval_s", "eval/return_mean"):  # fmt: skip
         assert f",{tag}," in csv_text
     tags = read_event_tags(trained_run / "tensorboard")
     assert {"ppo/approx_kl", "perf/steps_per_s"} <= tags
@@ -100,15 +101,15 @@ def test_bad_input_is_a_clear_error(args, message, capsys, tmp_path, monkeypatch
     assert not (tmp_path / "runs").exists()  # nothing written for a rejected command
 
 
-def test_train_draws_the_learning_curve(trained_run):
-    from roto.eval.plots import plot_learning_curve, read_scalars
+def test_train_records_evaluations_and_draws_the_learning_curve(trained_run, tmp_path):
+    from roto.eval.plots import plot_learning_curve
+    from roto.rl.evaluation import read_evaluations
 
-    series = read_scalars(trained_run)
-    assert "ppo/lr" in series and len(series["ppo/lr"][0]) >= 3
-    if "eval/return_mean" in series:  # evaluation rounds closed: the trainer drew the curve
-        assert (trained_run / "learning_curve.png").stat().st_size > 1000
-    csv_path = trained_run / "scalars.csv"
-    with csv_path.open("a") as f:  # a synthetic closed round always gives a figure
-        f.write("100,9,eval/return_mean,5\n100,9,eval/return_std,1\n100,9,eval/bounces_mean,0.5\n")
-    out = plot_learning_curve(trained_run, trained_run / "curve.png")
+    records = read_evaluations(trained_run)
+    # eval_every 25 with 3 updates: only the evaluation after the last update (then the resume's)
+    assert [r["update"] for r in records][:1] == [3] and records[0]["env_steps"] == 48
+    assert len(records[0]["per_episode"]["return"]) == 2  # run.num_eval_envs=2: one episode each
+    assert records[0]["return_mean"] == sum(records[0]["per_episode"]["return"]) / 2
+    out = plot_learning_curve(trained_run, tmp_path / "curve.png")
     assert out is not None and out.stat().st_size > 1000
+    assert plot_learning_curve(tmp_path) is None  # no evaluations: no figure

@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib.util
 from dataclasses import dataclass
 
-from roto.envs.observations import OBS_MODES
+from roto.envs.observations import OBS_GROUPS, OBS_MODES
 from roto.sim.backend import BACKENDS
 
 
@@ -18,6 +18,9 @@ class EnvConfig:
         robot: robot name (``shadow``).
         num_envs: number of parallel worlds B (>= 1).
         obs_mode: ``blind`` (proprio + tactile), ``state`` (+ privileged), ``proprio`` (no touch).
+        extra_groups: observation groups returned besides the obs mode's, for a learner that reads
+            them outside the policy (a privileged critic, an auxiliary target); the policy's input
+            stays the obs mode's groups.
         backend: physics backend (``cpu``: MuJoCo C threads; ``warp``: MuJoCo Warp, see docs/backends.md).
         device: torch device of all tensors the env returns, and where ``warp`` simulates
             (``cpu`` or ``cuda[:k]``; the ``cpu`` backend needs ``cpu``).
@@ -38,6 +41,7 @@ class EnvConfig:
     robot: str = "shadow"
     num_envs: int = 1
     obs_mode: str = "blind"
+    extra_groups: tuple[str, ...] = ()
     backend: str = "cpu"
     device: str = "cpu"
     seed: int = 0
@@ -60,6 +64,10 @@ class EnvConfig:
         get_robot(self.robot)
         if self.obs_mode not in OBS_MODES:
             raise ValueError(f"unknown obs_mode {self.obs_mode!r}; valid obs modes: {list(OBS_MODES)}")
+        object.__setattr__(self, "extra_groups", tuple(self.extra_groups))  # a list read back from YAML
+        for group in self.extra_groups:
+            if group not in OBS_GROUPS:
+                raise ValueError(f"unknown extra observation group {group!r}; valid groups: {list(OBS_GROUPS)}")
         if self.backend not in BACKENDS:
             raise ValueError(f"unknown backend {self.backend!r}; valid backends: {list(BACKENDS)}")
         if isinstance(self.num_envs, bool) or not isinstance(self.num_envs, int) or self.num_envs < 1:

@@ -1,8 +1,11 @@
-"""Per-frame observation groups (SPEC §4) and the frame stack, as batched torch."""
+"""Per-frame observation groups (docs/spec.md §4) and the frame stack, as batched torch."""
 
 from __future__ import annotations
 
 import torch
+
+OBS_GROUPS: tuple[str, ...] = ("tactile", "proprio", "privileged")
+"""Every observation group an env can return, in the order the env concatenates them."""
 
 OBS_MODES: dict[str, tuple[str, ...]] = {
     "blind": ("tactile", "proprio"),

@@ -22,7 +22,7 @@ from roto.envs.capacity import warp_capacity
 from roto.envs.columns import Columns
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
-from roto.envs.observations import OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
+from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
 from roto.envs.start_pool import StartPool
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
@@ -59,7 +59,8 @@ class RotoEnv:
         self.robot: RobotSpec = get_robot(config.robot)
         self.num_envs = config.num_envs
         self.device = resolve_device(config.device)
-        self.groups = OBS_MODES[config.obs_mode]
+        wanted = set(OBS_MODES[config.obs_mode]) | set(config.extra_groups)
+        self.groups = tuple(group for group in OBS_GROUPS if group in wanted)
         self.balls = self.task.balls(self.robot)
         self.model, self.layout = build_scene(self.robot, self.balls)
         nconmax, njmax = warp_capacity(config.robot, config.task)

@@ -9,7 +9,8 @@ import torch
 from roto.envs.roto_env import RotoEnv
 from roto.eval.episodes import first_episodes
 from roto.rl.networks import ActorCritic
-from roto.rl.runner import TrainSettings, flatten_obs, single_torch_thread
+from roto.rl.settings import TrainSettings
+from roto.rl.torch_threads import single_torch_thread
 
 MAX_PARALLEL_ENVS = 128
 
@@ -30,7 +31,7 @@ def evaluate(
         env = RotoEnv(settings.cpu_env_config(num_envs=n, seed=seed + batch))
         obs, _ = env.reset(seed=seed + batch)
         with single_torch_thread(env.device):
-            result = first_episodes(env, lambda o: model.act_deterministic(flatten_obs(o)), obs)
+            result = first_episodes(env, model.act_deterministic, obs)
         env.close()
         for name, values in result.items():
             key = {"r": "return", "l": "length"}.get(name, name)

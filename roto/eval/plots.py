@@ -1,9 +1,14 @@
-"""Learning curves from a run's ``scalars.csv``."""
+"""Learning curves from runs' ``evaluations.jsonl`` (one line per training-time evaluation)."""
 
 from __future__ import annotations
 
 import csv
 import pathlib
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from roto.rl.evaluation import read_evaluations
 
 
 def read_scalars(run_dir: str | pathlib.Path) -> dict[str, tuple[list[int], list[float]]]:
@@ -17,39 +22,78 @@ def read_scalars(run_dir: str | pathlib.Path) -> dict[str, tuple[list[int], list
     return series
 
 
+def curve_metrics(records: Sequence[Mapping]) -> list[str]:
+    """The per-episode quantities a run's evaluations hold, the return first, without the length."""
+    names = [key.removesuffix("_mean") for key in records[0] if key.endswith("_mean")]
+    return sorted((n for n in names if n != "length"), key=lambda n: (n != "return", n))
+
+
 def plot_learning_curve(run_dir: str | pathlib.Path, out: str | pathlib.Path | None = None) -> pathlib.Path | None:
-    """Plot the evaluation curves (mean ± std of each task metric and of the return) vs env steps.
+    """Evaluation mean ± std of the return and each task metric against env steps, best marked.
 
     Writes ``<run_dir>/learning_curve.png`` unless ``out`` is given; returns the path, or None when
-    no evaluation round has finished yet.
+    the run has no evaluation yet.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    run_dir = pathlib.Path(run_dir)
-    series = read_scalars(run_dir)
-    metrics = sorted(
-        tag.removeprefix("eval/").removesuffix("_mean")
-        for tag in series
-        if tag.startswith("eval/") and tag.endswith("_mean") and tag != "eval/length_mean"
-    )
-    if not metrics:
+    records = read_evaluations(run_dir)
+    if not records:
         return None
+    plt = _pyplot()
+    run_dir = pathlib.Path(run_dir)
+    metrics = curve_metrics(records)
+    steps = np.array([r["env_steps"] for r in records])
+    best = int(np.argmax([r["return_mean"] for r in records]))
     fig, axes = plt.subplots(1, len(metrics), figsize=(5 * len(metrics), 3.6), squeeze=False)
     for ax, name in zip(axes[0], metrics, strict=True):
-        steps, mean = series[f"eval/{name}_mean"]
-        _, std = series.get(f"eval/{name}_std", (steps, [0.0] * len(mean)))
+        mean = np.array([r[f"{name}_mean"] for r in records])
+        std = np.array([r[f"{name}_std"] for r in records])
         ax.plot(steps, mean, color="tab:blue")
-        ax.fill_between(steps, [m - s for m, s in zip(mean, std, strict=True)],
-                        [m + s for m, s in zip(mean, std, strict=True)], color="tab:blue", alpha=0.2)  # fmt: skip
+        ax.fill_between(steps, mean - std, mean + std, color="tab:blue", alpha=0.2)
+        ax.plot(steps[best], mean[best], "o", color="tab:red", label="best.pt")
         ax.set_xlabel("env steps")
         ax.set_ylabel(f"evaluation {name} (mean ± std)")
         ax.grid(alpha=0.3)
-    fig.suptitle(run_dir.name)
+    axes[0][0].legend(loc="upper left")
+    fig.suptitle(f"{run_dir.name}: {len(records[-1]['per_episode']['return'])} episodes per evaluation")
     fig.tight_layout()
     path = pathlib.Path(out) if out is not None else run_dir / "learning_curve.png"
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
+
+
+def plot_variants(
+    runs: Mapping[str, Sequence[str | pathlib.Path]], metric: str, out: str | pathlib.Path, title: str = ""
+) -> pathlib.Path:
+    """Evaluation ``metric`` against env steps: per variant, the mean over its runs (seeds) with a
+    band from the lowest to the highest run. Runs are cut to the evaluations they all have."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for variant, run_dirs in runs.items():
+        curves = [read_evaluations(d) for d in run_dirs]
+        length = min(len(c) for c in curves)
+        if length == 0:
+            continue
+        steps = np.array([r["env_steps"] for r in curves[0][:length]])
+        values = np.array([[r[f"{metric}_mean"] for r in c[:length]] for c in curves])
+        (line,) = ax.plot(steps, values.mean(axis=0), label=f"{variant} ({len(curves)} seeds)")
+        ax.fill_between(steps, values.min(axis=0), values.max(axis=0), color=line.get_color(), alpha=0.15)
+    ax.set_xlabel("env steps")
+    ax.set_ylabel(f"evaluation {metric} (mean over seeds)")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper left")
+    ax.set_title(title)
+    fig.tight_layout()
+    path = pathlib.Path(out)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def _pyplot():  # noqa: ANN202 (matplotlib.pyplot, imported late: headless backend, slow import)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt

@@ -13,7 +13,7 @@ import torch
 
 from roto.envs.roto_env import RotoEnv
 from roto.rl.networks import ActorCritic
-from roto.rl.runner import TrainSettings, flatten_obs
+from roto.rl.settings import TrainSettings
 
 TOUCH_RGBA = np.array([0.0, 0.85, 1.0, 1.0], dtype=np.float32)
 """Colour of a tactile link while its bit is on (cyan)."""
@@ -91,7 +91,7 @@ def record_video(
     writer = imageio.get_writer(str(path), format="FFMPEG", fps=FPS, codec="libx264", quality=7, macro_block_size=8)
     try:
         for _ in range(steps):
-            obs_dict, _, _, _, info = env.step(model.act_deterministic(flatten_obs(obs_dict)))
+            obs_dict, _, _, _, info = env.step(model.act_deterministic(obs_dict))
             writer.append_data(renderer.render())
             frames += 1
             if "episode" in info and bool(info["_episode"][0]):

@@ -1,8 +1,9 @@
 """Agent configuration: frozen dataclasses read from plain YAML with strict keys.
 
-A config file mirrors ``AgentConfig``: sections ``network``, ``ppo`` and ``run``. An unknown key is
-an error naming its dotted path; a missing key keeps its default. ``key=value`` overrides (e.g.
-``ppo.lr=1e-4``) are applied on top, with the value parsed as YAML.
+A config file mirrors ``AgentConfig``: sections ``network``, ``ppo``, ``ssl`` and ``run``. An unknown
+key is an error naming its dotted path and the valid keys; a missing key keeps its default.
+``key=value`` overrides (e.g. ``ppo.lr=1e-4``, ``ssl.forward_dynamics.weight=0.01``) are applied on
+top, with the value parsed as YAML.
 """
 
 from __future__ import annotations
@@ -11,27 +12,38 @@ import contextlib
 import dataclasses
 import importlib.resources
 import pathlib
+import types
 import typing
 from dataclasses import dataclass, field
 from typing import Any
 
 import yaml
 
+from roto.rl.ssl.configs import SSLConfig, check_groups
+
 
 @dataclass(frozen=True, kw_only=True)
 class NetworkConfig:
-    """Shared encoder and heads (SPEC §7)."""
+    """Encoder, heads and the observation groups each network reads (docs/spec.md §7)."""
 
     encoder: tuple[int, ...] = (512, 256)
+    """Hidden sizes of the encoder (Linear -> LayerNorm -> ELU each)."""
     policy_head: tuple[int, ...] = (128, 64)
     value_head: tuple[int, ...] = (128, 64)
     init_log_std: float = 0.0
     obs_normalization: bool = True
+    """Standardise each network's input with running statistics kept in the model (clip ±5)."""
+    actor: tuple[str, ...] | None = None
+    """Groups the actor (and its encoder, which the auxiliary losses train) reads; None: the obs
+    mode's groups. Always a subset of the obs mode's groups."""
+    critic: tuple[str, ...] | None = None
+    """Groups the critic reads; None: the actor's, through the shared encoder. Other groups give the
+    critic an encoder of its own (same sizes), e.g. [tactile, proprio, privileged] for a privileged critic."""
 
 
 @dataclass(frozen=True, kw_only=True)
 class PPOConfig:
-    """PPO hyperparameters (SPEC §7; defaults are roto's Bounce values)."""
+    """PPO hyperparameters (docs/spec.md §7; defaults are roto's Bounce values)."""
 
     rollouts: int = 16
     epochs: int = 17
@@ -57,10 +69,12 @@ class PPOConfig:
 class RunConfig:
     """Evaluation, logging and checkpoint cadence of a training run."""
 
-    num_eval_envs: int = 8
-    """Evaluation envs when the training envs simulate on the CPU (either backend)."""
+    num_eval_envs: int = 16
+    """Evaluation envs (one episode each per evaluation) when the envs simulate on the CPU."""
     num_eval_envs_gpu: int = 100
     """Evaluation envs when they simulate on a CUDA device (the paper's 100)."""
+    eval_every: int = 25
+    """Evaluate the current weights every this many updates (and after the last one)."""
     checkpoint_every: int = 50
     """Write ``latest.pt`` (and keep ``agent_<update>.pt``) every this many updates."""
 
@@ -71,6 +85,7 @@ class AgentConfig:
 
     network: NetworkConfig = field(default_factory=NetworkConfig)
     ppo: PPOConfig = field(default_factory=PPOConfig)
+    ssl: SSLConfig = field(default_factory=SSLConfig)
     run: RunConfig = field(default_factory=RunConfig)
 
     def validate(self) -> AgentConfig:
@@ -79,6 +94,7 @@ class AgentConfig:
         positive = {"ppo.rollouts": p.rollouts, "ppo.epochs": p.epochs, "ppo.minibatches": p.minibatches}
         positive["run.num_eval_envs"] = self.run.num_eval_envs
         positive["run.num_eval_envs_gpu"] = self.run.num_eval_envs_gpu
+        positive["run.eval_every"] = self.run.eval_every
         positive["run.checkpoint_every"] = self.run.checkpoint_every
         for name, value in positive.items():
             if value < 1:
@@ -87,18 +103,28 @@ class AgentConfig:
             raise ValueError(f"ppo.gamma must be in (0, 1] and ppo.lam in [0, 1], got {p.gamma}, {p.lam}")
         if p.lr <= 0.0:
             raise ValueError(f"ppo.lr must be > 0, got {p.lr}")
+        for name in ("actor", "critic"):
+            groups = getattr(self.network, name)
+            if groups is not None:
+                check_groups(groups, f"network.{name}")
+        self.ssl.check()
         return self
 
 
 def _coerce(value: Any, annotation: Any, path: str) -> Any:
     origin = typing.get_origin(annotation)
+    if origin is types.UnionType:  # X | None
+        (inner,) = [a for a in typing.get_args(annotation) if a is not type(None)]
+        return None if value is None else _coerce(value, inner, path)
     if dataclasses.is_dataclass(annotation):
         return from_dict(annotation, value, path)
     if origin is tuple:
+        item = typing.get_args(annotation)[0]
+        kind = {int: "integers", str: "group names"}[item]
         if not isinstance(value, list | tuple) or not all(
-            isinstance(v, int) and not isinstance(v, bool) for v in value
+            isinstance(v, item) and not isinstance(v, bool) for v in value
         ):
-            raise ValueError(f"{path} must be a list of integers, got {value!r}")
+            raise ValueError(f"{path} must be a list of {kind}, got {value!r}")
         return tuple(value)
     if annotation is bool:
         if not isinstance(value, bool):
@@ -136,7 +162,7 @@ def from_dict(cls: type, data: Any, path: str = "") -> Any:
 
 
 def to_dict(config: Any) -> dict[str, Any]:
-    """Plain nested dict (tuples as lists), ready for YAML."""
+    """Plain nested dict (tuples as lists, switched-off losses left out), ready for YAML."""
 
     def plain(value: Any) -> Any:
         if isinstance(value, tuple):
@@ -145,7 +171,10 @@ def to_dict(config: Any) -> dict[str, Any]:
             return {k: plain(v) for k, v in value.items()}
         return value
 
-    return plain(dataclasses.asdict(config))
+    data = plain(dataclasses.asdict(config))
+    if "ssl" in data:
+        data["ssl"] = {name: loss for name, loss in data["ssl"].items() if loss is not None}
+    return data
 
 
 def apply_overrides(data: dict[str, Any], overrides: list[str]) -> dict[str, Any]:
@@ -165,19 +194,32 @@ def apply_overrides(data: dict[str, Any], overrides: list[str]) -> dict[str, Any
     return merged
 
 
-def default_config_path(task: str) -> pathlib.Path:
-    """The packaged default agent config of a task (``roto/configs/<task>.yaml``)."""
-    return pathlib.Path(str(importlib.resources.files("roto") / "configs" / f"{task}.yaml"))
+def packaged_configs() -> dict[str, pathlib.Path]:
+    """{name: path} of the agent configs shipped in ``roto/configs`` (e.g. ``bounce_forward_dynamics``)."""
+    folder = importlib.resources.files("roto") / "configs"
+    return {pathlib.Path(str(p)).stem: pathlib.Path(str(p)) for p in folder.iterdir() if p.name.endswith(".yaml")}
+
+
+def resolve_config_path(task: str, path: str | pathlib.Path | None) -> pathlib.Path:
+    """The YAML file a ``--agent_cfg`` value means: a file, a packaged config's name, or (None) the task's default."""
+    shipped = packaged_configs()
+    if path is None:
+        return shipped[task]
+    source = pathlib.Path(path)
+    if source.is_file():
+        return source
+    if str(path) in shipped:
+        return shipped[str(path)]
+    raise FileNotFoundError(
+        f"agent config {str(path)!r} does not exist; give a YAML file or a packaged config: {sorted(shipped)}"
+    )
 
 
 def load_agent_config(
     task: str, path: str | pathlib.Path | None = None, overrides: list[str] | None = None
 ) -> AgentConfig:
-    """The task's default config, or the YAML file at ``path``, with ``overrides`` applied; validated."""
-    source = pathlib.Path(path) if path is not None else default_config_path(task)
-    if not source.is_file():
-        raise FileNotFoundError(f"agent config {str(source)!r} does not exist")
-    data = yaml.safe_load(source.read_text()) or {}
+    """The task's default config, or ``path`` (a YAML file or packaged name), with ``overrides``; validated."""
+    data = yaml.safe_load(resolve_config_path(task, path).read_text()) or {}
     data = apply_overrides(data, overrides or [])
     return from_dict(AgentConfig, data).validate()
 
@@ -187,8 +229,10 @@ __all__ = [
     "NetworkConfig",
     "PPOConfig",
     "RunConfig",
+    "SSLConfig",
     "apply_overrides",
     "from_dict",
     "load_agent_config",
+    "packaged_configs",
     "to_dict",
 ]

@@ -1,15 +1,24 @@
-"""One PPO update over a filled rollout buffer (SPEC §7)."""
+"""roto's PPO (docs/spec.md §7): the algorithm owns its transitions, returns and update.
+
+The runner calls, per rollout step, ``act(obs)`` then ``process_step(...)`` with what the env
+returned; after the rollout ``compute_returns(next_obs)`` and ``update()``. The update minimises a
+weighted sum of named loss terms (surrogate, value, entropy and each auxiliary loss), each logged
+as ``loss/<name>``.
+"""
 
 from __future__ import annotations
+
+from typing import Any
 
 import torch
 from torch import nn
 
 from roto.rl.config import PPOConfig
 from roto.rl.gae import compute_gae
-from roto.rl.losses import kl_adaptive_lr, ppo_loss
-from roto.rl.networks import ActorCritic
+from roto.rl.losses import kl_adaptive_lr, ppo_terms, weighted_sum
+from roto.rl.networks import ActorCritic, Obs
 from roto.rl.normalizers import RunningStandardScaler
+from roto.rl.ssl import AuxLoss, aux_epochs
 from roto.rl.storage import RolloutBuffer
 
 
@@ -20,13 +29,31 @@ def explained_variance(prediction: torch.Tensor, target: torch.Tensor) -> torch.
 
 
 class PPO:
-    """The learner: actor-critic, Adam, optional value-target scaler and KL-adaptive learning rate."""
+    """The learner: actor-critic, Adam, value-target scaler, KL-adaptive lr and auxiliary losses.
 
-    def __init__(self, model: ActorCritic, config: PPOConfig) -> None:
-        self.model, self.config = model, config
+    Args:
+        model: the actor-critic.
+        config: PPO hyperparameters.
+        storage: the rollout buffer ``process_step`` fills.
+        generator: draws actions and minibatch permutations (its state is part of ``state_dict``).
+        aux_losses: auxiliary losses trained with PPO's update (none for plain PPO).
+    """
+
+    def __init__(
+        self,
+        model: ActorCritic,
+        config: PPOConfig,
+        storage: RolloutBuffer,
+        generator: torch.Generator,
+        aux_losses: list[AuxLoss] | None = None,
+    ) -> None:
+        self.model, self.config, self.storage, self.generator = model, config, storage, generator
+        self.aux_losses = list(aux_losses or [])
         self.optimizer = torch.optim.Adam(model.parameters(), lr=config.lr)
         self.lr = config.lr
         self.value_scaler = RunningStandardScaler(1, clip=None) if config.value_normalization else None
+        self.value_scaler = self.value_scaler.to(storage.values.device) if self.value_scaler is not None else None
+        self._step: dict[str, Any] = {}
 
     # -------------------------------------------------------------- values in return units
 
@@ -41,14 +68,39 @@ class PPO:
             return values
         return self.value_scaler(values.unsqueeze(-1)).squeeze(-1)
 
-    # ------------------------------------------------------------------------- the update
+    # ------------------------------------------------------------------------ transitions
 
-    def finish_rollout(self, buffer: RolloutBuffer, last_values: torch.Tensor) -> None:
+    @torch.no_grad()
+    def act(self, obs: Obs) -> torch.Tensor:
+        """Sample actions (B, n) for observations ``obs``; remember them for ``process_step``."""
+        mean, log_std, value, _ = self.model(obs)
+        std = log_std.exp().expand_as(mean)
+        action = mean + std * torch.randn(mean.shape, generator=self.generator, device=mean.device)
+        log_prob = torch.distributions.Normal(mean, std).log_prob(action).sum(-1)
+        self._step = {"obs": obs, "action": action, "log_prob": log_prob, "value": self.values(value)}
+        return action
+
+    @torch.no_grad()
+    def process_step(
+        self, reward: torch.Tensor, terminated: torch.Tensor, truncated: torch.Tensor, info: dict[str, Any]
+    ) -> None:
+        """Store the transition of the last ``act``; with ``bootstrap_timeouts``, add γ·V(final obs)
+        to the reward of time-outs (the final observation is ``info["final_obs"]``)."""
+        reward = reward.clone()
+        if self.config.bootstrap_timeouts and "final_obs" in info:
+            final_values = self.values(self.model.value(info["final_obs"]))
+            reward += self.config.gamma * final_values * truncated.to(reward.dtype)
+        s = self._step
+        self.storage.add(s["obs"], s["action"], s["log_prob"], s["value"], reward, terminated | truncated)
+
+    @torch.no_grad()
+    def compute_returns(self, next_obs: Obs) -> None:
         """GAE in return units, then store advantages (normalised) and value targets in head units.
 
-        ``buffer.values`` holds return-unit values from the rollout; ``last_values`` (B,) too.
+        ``next_obs``: the observation after the rollout's last step (bootstraps the last values).
         """
-        c = self.config
+        c, buffer = self.config, self.storage
+        last_values = self.values(self.model.value(next_obs))
         advantages, returns = compute_gae(buffer.rewards, buffer.values, buffer.dones, last_values, c.gamma, c.lam)
         if self.value_scaler is not None:
             self.value_scaler.update(returns.reshape(-1, 1))
@@ -56,61 +108,98 @@ class PPO:
         buffer.values = self._normalise(buffer.values)
         buffer.advantages = (advantages - advantages.mean()) / (advantages.std() + 1e-8)
 
-    def update(self, buffer: RolloutBuffer, generator: torch.Generator) -> dict[str, float]:
-        """``epochs`` passes of minibatch SGD on the clipped PPO loss; returns mean diagnostics."""
-        c = self.config
+    # ------------------------------------------------------------------------- the update
+
+    def update(self) -> dict[str, float]:
+        """``epochs`` passes of minibatch SGD; then the observation statistics; clears the buffer.
+
+        Returns the mean of each loss term (``loss/<name>``), auxiliary metrics
+        (``<loss>/<metric>``) and PPO diagnostics (``ppo/<name>``).
+        """
+        c, buffer = self.config, self.storage
+        aux_batches = {aux.name: aux.prepare(buffer, c.minibatches, self.generator) for aux in self.aux_losses}
         sums: dict[str, torch.Tensor] = {}
-        count = 0
-        for _ in range(c.epochs):
+        counts: dict[str, int] = {}
+        for epoch in range(c.epochs):
+            active = [aux for aux in self.aux_losses if epoch < aux_epochs(c.epochs, aux.config.epoch_ratio)]
             epoch_kl = []
-            for batch in buffer.minibatches(c.minibatches, generator):
-                dist, value = self.model.distribution(batch["obs"])
-                log_prob = dist.log_prob(batch["actions"]).sum(-1)
-                entropy = dist.entropy().sum(-1)
-                loss, metrics = ppo_loss(
-                    log_prob,
-                    batch["log_probs"],
-                    batch["advantages"],
-                    value,
-                    batch["values"],
-                    batch["returns"],
-                    entropy,
-                    c.ratio_clip,
-                    c.value_clip,
-                    c.value_coef,
-                    c.entropy_coef,
-                )
-                self.optimizer.zero_grad(set_to_none=True)
-                loss.backward()
-                metrics["grad_norm"] = nn.utils.clip_grad_norm_(self.model.parameters(), c.max_grad_norm)
-                self.optimizer.step()
-                epoch_kl.append(metrics["approx_kl"])
-                for name, value_ in metrics.items():
-                    sums[name] = sums.get(name, 0.0) + value_.detach()
-                count += 1
+            for i, batch in enumerate(buffer.minibatches(c.minibatches, self.generator)):
+                metrics = self._minibatch_step(batch, [(aux, aux_batches[aux.name][i]) for aux in active])
+                epoch_kl.append(metrics["ppo/approx_kl"])
+                for name, value in metrics.items():
+                    sums[name] = sums.get(name, 0.0) + value
+                    counts[name] = counts.get(name, 0) + 1
             if c.kl_adaptive:
-                self.lr = kl_adaptive_lr(
-                    self.lr, float(torch.stack(epoch_kl).mean()), c.kl_target, c.kl_factor, c.lr_min, c.lr_max
-                )
-                for group in self.optimizer.param_groups:
-                    group["lr"] = self.lr
-        out = {name: float(total / count) for name, total in sums.items()}
-        out["explained_variance"] = float(explained_variance(buffer.values, buffer.returns))
-        out["action_std"] = float(self.model.log_std.detach().clamp(-20, 2).exp().mean())
-        out["lr"] = self.lr
+                self._adapt_lr(float(torch.stack(epoch_kl).mean()))
+        out = {name: float(total / counts[name]) for name, total in sums.items()}
+        out["ppo/explained_variance"] = float(explained_variance(buffer.values, buffer.returns))
+        out["ppo/action_std"] = float(self.model.log_std.detach().clamp(-20, 2).exp().mean())
+        out["ppo/lr"] = self.lr
+        self.model.update_normalizers(buffer.flat_obs())
+        buffer.clear()
         return out
 
-    def state_dict(self) -> dict:
-        """Optimiser, learning rate and value scaler."""
+    def _minibatch_step(self, batch: dict, aux: list[tuple[AuxLoss, Any]]) -> dict[str, torch.Tensor]:
+        """One backward of the weighted loss terms, PPO's Adam step, then each active loss's own step."""
+        c = self.config
+        mean, log_std, value, latent = self.model(batch["obs"])
+        dist = torch.distributions.Normal(mean, log_std.exp().expand_as(mean))
+        terms, diagnostics = ppo_terms(
+            dist.log_prob(batch["actions"]).sum(-1),
+            batch["log_probs"],
+            batch["advantages"],
+            value,
+            batch["values"],
+            batch["returns"],
+            dist.entropy().sum(-1),
+            ratio_clip=c.ratio_clip,
+            value_clip=c.value_clip,
+        )
+        weights = {"surrogate": 1.0, "value": c.value_coef, "entropy": -c.entropy_coef}
+        metrics = {f"ppo/{name}": value_ for name, value_ in diagnostics.items()}
+        for loss_fn, aux_batch in aux:
+            terms[loss_fn.name], aux_metrics = loss_fn.loss(self.model, batch, latent, aux_batch)
+            weights[loss_fn.name] = loss_fn.config.weight
+            metrics.update({f"{loss_fn.name}/{k}": v for k, v in aux_metrics.items()})
+        total = weighted_sum(terms, weights)
+        self.optimizer.zero_grad(set_to_none=True)
+        for loss_fn, _ in aux:
+            loss_fn.optimizer.zero_grad(set_to_none=True)
+        total.backward()
+        # the clip covers the actor-critic (encoder included), never the auxiliary heads
+        metrics["ppo/grad_norm"] = nn.utils.clip_grad_norm_(self.model.parameters(), c.max_grad_norm)
+        self.optimizer.step()
+        for loss_fn, _ in aux:
+            loss_fn.optimizer.step()
+            loss_fn.after_step(self.model)
+        metrics.update({f"loss/{name}": value_.detach() for name, value_ in terms.items()})
+        metrics["loss/total"] = total.detach()
+        return metrics
+
+    def _adapt_lr(self, kl: float) -> None:
+        c = self.config
+        self.lr = kl_adaptive_lr(self.lr, kl, c.kl_target, c.kl_factor, c.lr_min, c.lr_max)
+        for group in self.optimizer.param_groups:
+            group["lr"] = self.lr
+
+    # ------------------------------------------------------------------------ checkpoints
+
+    def state_dict(self) -> dict[str, Any]:
+        """Optimiser, learning rate, value scaler, generator and each auxiliary loss's state."""
         return {
             "optimizer": self.optimizer.state_dict(),
             "lr": self.lr,
             "value_scaler": None if self.value_scaler is None else self.value_scaler.state_dict(),
+            "generator": self.generator.get_state(),
+            "aux": {aux.name: aux.state_dict() for aux in self.aux_losses},
         }
 
-    def load_state_dict(self, state: dict) -> None:
+    def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore ``state_dict``'s output."""
         self.optimizer.load_state_dict(state["optimizer"])
         self.lr = float(state["lr"])
         if self.value_scaler is not None:
             self.value_scaler.load_state_dict(state["value_scaler"])
+        self.generator.set_state(state["generator"].cpu())  # RNG states are CPU byte tensors
+        for aux in self.aux_losses:
+            aux.load_state_dict(state["aux"][aux.name])

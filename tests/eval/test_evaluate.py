@@ -20,7 +20,10 @@ class ThreadRecordingPolicy(ActorCritic):
 
 def test_evaluate_runs_whole_episodes_on_one_torch_thread_and_restores_the_count():
     settings = TrainSettings(env=EnvConfig(task="bounce", robot="shadow", num_envs=2, threads=2))
-    policy = ThreadRecordingPolicy(388, 20, encoder=(32,), policy_head=(16,), value_head=(16,))
+    sizes = {"tactile": 68, "proprio": 320}
+    policy = ThreadRecordingPolicy(
+        sizes, 20, actor_groups=("tactile", "proprio"), encoder=(32,), policy_head=(16,), value_head=(16,)
+    )
     before = torch.get_num_threads()
     torch.set_num_threads(2)
     try:

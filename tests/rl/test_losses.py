@@ -3,11 +3,11 @@ import math
 import pytest
 import torch
 
-from roto.rl.losses import kl_adaptive_lr, ppo_loss
+from roto.rl.losses import kl_adaptive_lr, ppo_terms, weighted_sum
 
 
 def test_ppo_loss_terms_on_a_hand_checked_batch():
-    loss, m = ppo_loss(
+    terms, m = ppo_terms(
         log_prob=torch.tensor([math.log(1.5), math.log(0.5)]),
         old_log_prob=torch.zeros(2),
         advantages=torch.tensor([1.0, -1.0]),
@@ -17,15 +17,16 @@ def test_ppo_loss_terms_on_a_hand_checked_batch():
         entropy=torch.tensor([1.0, 3.0]),
         ratio_clip=0.2,
         value_clip=0.2,
-        value_coef=0.5,
-        entropy_coef=0.01,
     )
     # ratios 1.5, 0.5 -> min(surrogate, clipped) = 1.2, -0.8 -> policy loss -0.2
-    assert m["policy_loss"].item() == pytest.approx(-0.2)
+    assert terms["surrogate"].item() == pytest.approx(-0.2)
     # clipped values 0.7, 0.3 -> ((2 - 0.7)^2 + 0.3^2) / 2
-    assert m["value_loss"].item() == pytest.approx(0.89)
-    assert m["entropy"].item() == pytest.approx(2.0)
+    assert terms["value"].item() == pytest.approx(0.89)
+    assert terms["entropy"].item() == pytest.approx(2.0)
+    loss = weighted_sum(terms, {"surrogate": 1.0, "value": 0.5, "entropy": -0.01})
     assert loss.item() == pytest.approx(-0.2 + 0.5 * 0.89 - 0.01 * 2.0)
+    with pytest.raises(KeyError, match="value"):
+        weighted_sum(terms, {"surrogate": 1.0, "entropy": -0.01})
     assert m["approx_kl"].item() == pytest.approx(((0.5 - math.log(1.5)) + (-0.5 + math.log(2.0))) / 2)
     assert m["clip_fraction"].item() == 1.0
 
@@ -33,9 +34,9 @@ def test_ppo_loss_terms_on_a_hand_checked_batch():
 def test_unclipped_ratio_gives_the_plain_policy_gradient():
     logp = torch.zeros(3, requires_grad=True)
     adv = torch.tensor([1.0, 2.0, -3.0])
-    loss, _ = ppo_loss(logp, torch.zeros(3), adv, torch.zeros(3), torch.zeros(3), torch.zeros(3), torch.zeros(3),
-                       0.2, 0.2, 1.0, 0.0)  # fmt: skip
-    loss.backward()
+    terms, _ = ppo_terms(logp, torch.zeros(3), adv, torch.zeros(3), torch.zeros(3), torch.zeros(3), torch.zeros(3),
+                         ratio_clip=0.2, value_clip=0.2)  # fmt: skip
+    terms["surrogate"].backward()
     assert logp.grad.tolist() == pytest.approx((-adv / 3).tolist())
 
 

@@ -51,7 +51,7 @@ def test_resume_continues_bit_identically(tmp_path):
     pw, pr = params(whole), params(resumed)
     assert all(torch.equal(pw[k], pr[k]) for k in pw)
     assert (
-        resumed.ppo.optimizer.state_dict()["state"][0]["step"] == whole.ppo.optimizer.state_dict()["state"][0]["step"]
+        resumed.alg.optimizer.state_dict()["state"][0]["step"] == whole.alg.optimizer.state_dict()["state"][0]["step"]
     )
 
 
@@ -62,7 +62,9 @@ def test_resume_without_a_checkpoint_is_a_clear_error(tmp_path):
 
 def test_ppo_learns_the_toy_task(tmp_path):
     torch.set_num_threads(1)
-    settings = TrainSettings(env=EnvConfig(task="bounce", num_envs=32, seed=0), total_steps=32 * 8 * 60)
+    settings = TrainSettings(
+        env=EnvConfig(task="bounce", obs_mode="proprio", num_envs=32, seed=0), total_steps=32 * 8 * 60
+    )
     agent = load_agent_config(
         "bounce",
         overrides=[

@@ -1,0 +1,137 @@
+"""Train agent variants on one (task, robot, obs mode) over seeds, evaluate them, tabulate and plot.
+
+    python benchmarks/agent_variants.py bounce --steps 5000000 --seeds 0 1 --out benchmarks/results
+
+Every (variant, seed) is an ordinary run directory under ``--runs`` (``<runs>/<task>/<variant>/seed<k>``).
+The script is resumable: rerun the same command and finished runs are skipped, interrupted ones
+continue from their latest checkpoint, and missing final evaluations are done. Each run's final
+policy (``latest.pt``) and best policy (``best.pt``) are evaluated over ``--episodes`` fresh
+episodes, as ``roto eval`` does. The results go to ``<out>/variants_<task>_<robot>_<obs>.json``
+(every figure, with the commit) and a curve of the evaluation metric per variant (mean over seeds).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import subprocess
+import time
+
+import torch
+
+from roto.envs.config import EnvConfig
+from roto.eval.evaluate import evaluate
+from roto.eval.plots import plot_variants
+from roto.rl.config import load_agent_config
+from roto.rl.evaluation import read_evaluations
+from roto.rl.runner import CHECKPOINT_DIR, Trainer, TrainSettings, load_policy
+
+FD = "weight: 0.0021, lr: 1.5e-5, seq_length: 8"
+"""roto's tuned Bounce forward-dynamics coefficients (docs/spec.md §7a), used by both FD variants."""
+
+VARIANTS = {
+    "bounce": {
+        "config": "bounce_cpu_quickstart",
+        "ppo": [],
+        "forward_dynamics": [f"ssl.forward_dynamics={{{FD}}}"],
+        "forward_dynamics_memory": [f"ssl.forward_dynamics_memory={{{FD}}}"],
+        "privileged_critic": ["network.critic=[tactile, proprio, privileged]"],
+    },
+    "baoding": {
+        "config": "baoding_cpu",
+        "ppo": [],
+        "forward_dynamics_memory": ["ssl.forward_dynamics_memory={weight: 0.025, lr: 2.5e-4, seq_length: 2}"],
+    },
+}
+"""Per task: the base agent config (a packaged name) and each variant's overrides on top of it."""
+
+METRIC = {"bounce": "bounces", "baoding": "rotations"}
+
+
+def train_one(task: str, variant: str, seed: int, args: argparse.Namespace) -> pathlib.Path:
+    """Train (or resume, or skip) one run; its run directory."""
+    run_dir = pathlib.Path(args.runs) / task / variant / f"seed{seed}"
+    if (run_dir / CHECKPOINT_DIR / "latest.pt").is_file():
+        trainer = Trainer.resume(run_dir, total_steps=args.steps)
+    else:
+        env = EnvConfig(task=task, robot=args.robot, obs_mode=args.obs, num_envs=args.num_envs, seed=seed,
+                        threads=args.threads)  # fmt: skip
+        agent = load_agent_config(task, VARIANTS[task]["config"], VARIANTS[task][variant])
+        trainer = Trainer(TrainSettings(env=env, total_steps=args.steps), agent, run_dir)
+    if trainer.update < trainer.total_updates:
+        print(f"{task}/{variant}/seed{seed}: training from update {trainer.update}", flush=True)
+        trainer.train(progress=False)
+    trainer.env.close()
+    trainer.evaluator.env.close()
+    return run_dir
+
+
+def final_evaluations(run_dir: pathlib.Path, episodes: int) -> dict[str, dict]:
+    """``roto eval`` of latest.pt and best.pt over ``episodes`` episodes (cached next to them)."""
+    out = {}
+    for name in ("latest", "best"):
+        cache = run_dir / CHECKPOINT_DIR / f"{name}.eval{episodes}.json"
+        if not cache.is_file():
+            model, settings, _ = load_policy(run_dir / CHECKPOINT_DIR / f"{name}.pt")
+            result = evaluate(model, settings, episodes=episodes)
+            cache.write_text(json.dumps(result))
+        result = json.loads(cache.read_text())
+        out[name] = {k: v for k, v in result.items() if k != "per_episode"}
+    return out
+
+
+def summarize_run(run_dir: pathlib.Path, episodes: int) -> dict:
+    """What the results table needs of one run."""
+    records = read_evaluations(run_dir)
+    best = max(records, key=lambda r: r["return_mean"])
+    return {
+        "run_dir": str(run_dir),
+        "train_wall_s": records[-1]["train_wall_s"],
+        "env_steps": records[-1]["env_steps"],
+        "best_update": best["update"],
+        "evaluations": [{k: v for k, v in r.items() if k != "per_episode"} for r in records],
+        "eval": final_evaluations(run_dir, episodes),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("task", choices=sorted(VARIANTS))
+    parser.add_argument("--variants", nargs="*", default=None, help="default: every variant of the task")
+    parser.add_argument("--robot", default="shadow")
+    parser.add_argument("--obs", default="blind")
+    parser.add_argument("--steps", type=int, default=5_000_000)
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
+    parser.add_argument("--num_envs", type=int, default=128)
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--torch_threads", type=int, default=2)
+    parser.add_argument("--episodes", type=int, default=100)
+    parser.add_argument("--runs", default="runs/variants")
+    parser.add_argument("--out", default="benchmarks/results")
+    args = parser.parse_args()
+    torch.set_num_threads(args.torch_threads)
+    variants = args.variants or [v for v in VARIANTS[args.task] if v != "config"]
+    start = time.time()
+    results: dict[str, list[dict]] = {}
+    for seed in args.seeds:  # seed-major: every variant gets its first seed before any gets a second
+        for variant in variants:
+            run_dir = train_one(args.task, variant, seed, args)
+            results.setdefault(variant, []).append(summarize_run(run_dir, args.episodes))
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    stem = f"variants_{args.task}_{args.robot}_{args.obs}"
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    meta = {"commit": commit, "steps": args.steps, "seeds": args.seeds, "num_envs": args.num_envs,
+            "threads": args.threads, "episodes": args.episodes, "base_config": VARIANTS[args.task]["config"],
+            "overrides": {v: VARIANTS[args.task][v] for v in variants}}  # fmt: skip
+    (out / f"{stem}.json").write_text(json.dumps({"meta": meta, "results": results}, indent=1))
+    metric = METRIC[args.task]
+    runs = {v: [r["run_dir"] for r in rs] for v, rs in results.items()}
+    title = f"{args.task} / {args.robot} / {args.obs}, {args.num_envs} envs, commit {commit}"
+    plot_variants(runs, metric, out / f"{stem}.png", title=title)
+    print(f"done in {time.time() - start:.0f} s: {out / stem}.json", flush=True)
+
+
+if __name__ == "__main__":
+    main()

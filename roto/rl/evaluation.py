@@ -1,0 +1,81 @@
+"""Training-time evaluation: the current weights, frozen, one full episode per evaluation env.
+
+Each evaluation resets the evaluation envs with the same seed (so every evaluation of a run starts
+from the same episode starts), runs the deterministic (mean) action until every env has finished
+its first episode, and appends one JSON line to ``<run_dir>/evaluations.jsonl``.
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import time
+from typing import Any
+
+import torch
+
+from roto.eval.episodes import first_episodes
+from roto.rl.networks import ActorCritic
+from roto.rl.torch_threads import single_torch_thread
+
+EVALUATIONS_NAME = "evaluations.jsonl"
+EPISODE_KEYS = {"r": "return", "l": "length"}
+
+
+def summarize(per_episode: dict[str, list[float]]) -> dict[str, float]:
+    """{"<name>_mean", "<name>_std"} (population std) of each per-episode list."""
+    summary = {}
+    for name, values in per_episode.items():
+        t = torch.tensor(values, dtype=torch.float64)
+        summary[f"{name}_mean"] = float(t.mean())
+        summary[f"{name}_std"] = float(t.std(unbiased=False)) if len(values) > 1 else 0.0
+    return summary
+
+
+class PolicyEvaluator:
+    """Evaluates a policy on its own envs, which step only while it evaluates.
+
+    Args:
+        env: the evaluation envs (B of them: B episodes per evaluation).
+        seed: reset seed of every evaluation.
+        run_dir: where ``evaluations.jsonl`` is appended to.
+    """
+
+    def __init__(self, env: Any, seed: int, run_dir: pathlib.Path) -> None:
+        self.env, self.seed = env, seed
+        self.path = run_dir / EVALUATIONS_NAME
+
+    @torch.no_grad()
+    def evaluate(self, model: ActorCritic, **fields: float) -> dict[str, Any]:
+        """Run one episode per env with ``model``'s mean action; append and return the record.
+
+        ``fields`` (update, env steps, training wall time ...) lead the record; then the mean and
+        std of the return, length and each task metric, and the per-episode lists.
+        """
+        start = time.perf_counter()
+        obs, _ = self.env.reset(seed=self.seed)
+        was_training = model.training
+        model.eval()
+        with single_torch_thread(self.env.device):
+            result = first_episodes(self.env, model.act_deterministic, obs)
+        model.train(was_training)
+        per_episode = {EPISODE_KEYS.get(name, name): values[:, 0].tolist() for name, values in result.items()}
+        record = {**fields, "eval_s": time.perf_counter() - start, **summarize(per_episode)}
+        record["per_episode"] = per_episode
+        with self.path.open("a") as f:
+            f.write(json.dumps(record) + "\n")
+        return record
+
+    def drop_after(self, update: int) -> None:
+        """Forget records of updates after ``update`` (a resumed run repeats them)."""
+        if self.path.is_file():
+            kept = [line for line in self.path.read_text().splitlines() if json.loads(line)["update"] <= update]
+            self.path.write_text("".join(line + "\n" for line in kept))
+
+
+def read_evaluations(run_dir: str | pathlib.Path) -> list[dict[str, Any]]:
+    """Every record of ``<run_dir>/evaluations.jsonl`` (empty if there is none)."""
+    path = pathlib.Path(run_dir) / EVALUATIONS_NAME
+    if not path.is_file():
+        return []
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
