@@ -27,8 +27,9 @@ from roto.rl.config import load_agent_config
 from roto.rl.evaluation import read_evaluations
 from roto.rl.runner import CHECKPOINT_DIR, Trainer, TrainSettings, load_policy
 
-FD = "weight: 0.0021, lr: 1.5e-5, seq_length: 8"
-"""roto's tuned Bounce forward-dynamics coefficients (docs/spec.md §7a), used by both FD variants."""
+FD = "weight: 0.0021, lr: 1.5e-5, seq_length: 8, max_sequences: 292"
+"""roto's tuned Bounce forward-dynamics coefficients (docs/spec.md §7a), used by both FD variants,
+with at most 292 = 16 x 128 / 7 sequences per update, about one pass over the rollout's observations."""
 
 VARIANTS = {
     "bounce": {

@@ -90,7 +90,7 @@ def plot_variants(
     return path
 
 
-def _pyplot():  # noqa: ANN202 (matplotlib.pyplot, imported late: headless backend, slow import)
+def _pyplot():  # matplotlib.pyplot, imported late (headless backend, slow import)
     import matplotlib
 
     matplotlib.use("Agg")

@@ -68,6 +68,10 @@ class ForwardDynamicsConfig(AuxLossConfig):
     """Hidden sizes of the residual latent model g(z, a) = z + MLP([z, a]) (ELU); output = latent width."""
     projector: tuple[int, ...] = (256,)
     """Hidden sizes of the projector on the prediction (ELU), then a linear layer to the latent width."""
+    max_sequences: int = 0
+    """Sequences trained on per update, drawn at random without replacement from those available;
+    0: all of them (roto). Overlapping windows encode each observation up to L times, so a cap
+    of about rollouts x num_envs / (L - 1) keeps the cost near one pass over the rollout."""
 
     def check(self, path: str) -> None:
         """As ``AuxLossConfig.check``, plus L >= 1 and tau in (0, 1]."""
@@ -76,6 +80,8 @@ class ForwardDynamicsConfig(AuxLossConfig):
             raise ValueError(f"{path}.seq_length must be >= 2 (observations per sequence), got {self.seq_length}")
         if not 0.0 < self.tau <= 1.0:
             raise ValueError(f"{path}.tau must be in (0, 1], got {self.tau}")
+        if self.max_sequences < 0:
+            raise ValueError(f"{path}.max_sequences must be >= 0 (0: all), got {self.max_sequences}")
 
 
 @dataclass(frozen=True, kw_only=True)

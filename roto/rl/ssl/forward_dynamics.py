@@ -74,8 +74,8 @@ class ForwardDynamics:
         return sequence_windows(buffer.obs, buffer.actions, buffer.dones, self.config.seq_length)
 
     def prepare(self, buffer: RolloutBuffer, num_minibatches: int, generator: torch.Generator) -> list[Any]:
-        """The update's sequences, shuffled once into one batch per PPO minibatch."""
-        return split_windows(self.windows(buffer), num_minibatches, generator)
+        """The update's sequences (at most ``max_sequences``), shuffled once into one batch per PPO minibatch."""
+        return split_windows(self.windows(buffer), num_minibatches, generator, self.config.max_sequences)
 
     def loss(
         self, model: ActorCritic, batch: dict, latent: torch.Tensor, aux_batch: Any

@@ -34,14 +34,15 @@ def sequence_windows(obs: Mapping[str, torch.Tensor], actions: torch.Tensor, don
     }
 
 
-def split_windows(windows: dict, parts: int, generator: torch.Generator) -> list[dict]:
-    """Shuffle the S windows and cut them into ``parts`` batches of floor(S / parts) (the rest is dropped).
+def split_windows(windows: dict, parts: int, generator: torch.Generator, limit: int = 0) -> list[dict]:
+    """Shuffle the S windows and cut them into ``parts`` batches of floor(S' / parts), where S' is S
+    or, when ``limit`` > 0, at most ``limit`` (the rest of the shuffled windows is dropped).
 
     With fewer windows than parts every batch is empty; a loss on an empty batch is skipped.
     """
     count = windows["actions"].shape[0]
     order = torch.randperm(count, generator=generator, device=generator.device).to(windows["actions"].device)
-    size = count // parts
+    size = (min(count, limit) if limit > 0 else count) // parts
     batches = []
     for i in range(parts):
         index = order[i * size : (i + 1) * size]
