@@ -149,7 +149,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="roto", description="roto: the Robot Tactile Olympiad on MuJoCo")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p_train = sub.add_parser("train", help="train roto's PPO agent (progress bar, logs, checkpoints)")
+    p_train = sub.add_parser(
+        "train", help="train roto's PPO agent, optionally with auxiliary losses (progress bar, logs, checkpoints)"
+    )
     _add_env_args(p_train, num_envs=64)
     p_train.add_argument(
         "--obs", "--obs_mode", "--obs-mode", dest="obs", default="blind", help="blind, state or proprio"
@@ -158,7 +160,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--steps", type=int, default=None, help="env-step budget (default 1e6; with --resume: unchanged)"
     )
     p_train.add_argument(
-        "--agent_cfg", "--agent-cfg", dest="agent_cfg", default=None, help="agent YAML (default: the task's)"
+        "--agent_cfg",
+        "--agent-cfg",
+        dest="agent_cfg",
+        default=None,
+        help="agent YAML file, or a packaged config's name (e.g. bounce_forward_dynamics, "
+        "baoding_forward_dynamics_memory, bounce_privileged_critic; default: the task's PPO)",
     )
     p_train.add_argument(
         "--run_dir", "--run-dir", dest="run_dir", default=None, help="default: runs/<task>_<robot>_<obs>/<time>"

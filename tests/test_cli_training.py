@@ -92,10 +92,20 @@ def test_play_writes_an_mp4_with_one_frame_per_step(trained_run, tmp_path):
         (["eval", "--checkpoint", "missing/latest.pt"], "does not exist"),
         (["play", "--checkpoint", "missing/latest.pt"], "does not exist"),
         (["train", "--resume", "missing_run"], "not a roto run directory"),
+        (["train", "--steps", "-5"], "step budget must be an integer >= 1, got -5"),
+        (["train", "--steps", "0"], "got 0"),
+        (
+            ["train", "--steps", "16", "ssl.jepa={}"],
+            "unknown config key 'ssl.jepa'; valid keys here: ['forward_dynamics'",
+        ),
+        (["train", "--steps", "16", "--agent_cfg", "bounce_fd"], "packaged config: ['baoding'"),
+        (["train", "--steps", "16", "network.actor=[privileged]"], "valid groups for this obs mode"),
+        (["eval", "--checkpoint", "config.yaml"], "'config.yaml' is not a roto checkpoint"),
     ],
 )
 def test_bad_input_is_a_clear_error(args, message, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
+    (tmp_path / "config.yaml").write_text("not: a checkpoint\n")
     assert main(args) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "runs").exists()  # nothing written for a rejected command

@@ -1,6 +1,6 @@
 import pytest
 
-from roto.rl.config import AgentConfig, apply_overrides, from_dict, load_agent_config
+from roto.rl.config import AgentConfig, apply_overrides, from_dict, load_agent_config, packaged_configs, to_dict
 
 
 @pytest.mark.parametrize("task", ["bounce", "baoding"])
@@ -41,3 +41,45 @@ def test_overrides_apply_and_validate():
 def test_missing_config_file_is_a_clear_error(tmp_path):
     with pytest.raises(FileNotFoundError, match="does not exist"):
         load_agent_config("bounce", tmp_path / "nope.yaml")
+
+
+@pytest.mark.parametrize("name", sorted(packaged_configs()))
+def test_every_packaged_config_loads_and_round_trips(name):
+    cfg = load_agent_config("bounce", name)
+    assert from_dict(AgentConfig, to_dict(cfg)) == cfg
+
+
+def test_tuned_ssl_configs_follow_the_spec():
+    fd = load_agent_config("bounce", "bounce_forward_dynamics")
+    assert (fd.ppo.rollouts, fd.ppo.epochs, fd.ppo.minibatches) == (16, 10, 8)
+    assert (fd.ssl.forward_dynamics.weight, fd.ssl.forward_dynamics.lr, fd.ssl.forward_dynamics.seq_length) == (
+        0.0021, 1.5e-5, 8)  # fmt: skip
+    memory = load_agent_config("baoding", "baoding_forward_dynamics_memory").ssl.forward_dynamics_memory
+    assert (memory.weight, memory.lr, memory.seq_length, memory.capacity) == (0.025, 2.5e-4, 2, 0)
+    recon = load_agent_config("baoding", "baoding_tactile_reconstruction").ssl.tactile_reconstruction
+    assert (recon.weight, recon.epoch_ratio, recon.targets) == (0.0031, 0.75, ("tactile",))
+    assert load_agent_config("bounce").ssl.enabled() == {}
+
+
+def test_ssl_section_has_strict_keys_and_checked_values():
+    with pytest.raises(
+        ValueError, match=r"unknown config key 'ssl.contrastive'; valid keys here: \['forward_dynamics'"
+    ):
+        from_dict(AgentConfig, {"ssl": {"contrastive": {}}})
+    with pytest.raises(ValueError, match=r"unknown config key 'ssl.forward_dynamics.horizon'.*'seq_length'"):
+        from_dict(AgentConfig, {"ssl": {"forward_dynamics": {"horizon": 3}}})
+    with pytest.raises(ValueError, match=r"ssl.forward_dynamics.seq_length must be >= 2"):
+        load_agent_config("bounce", overrides=["ssl.forward_dynamics={seq_length: 1}"])
+    with pytest.raises(ValueError, match=r"ssl.tactile_reconstruction.epoch_ratio must be in \(0, 1\]"):
+        load_agent_config("bounce", overrides=["ssl.tactile_reconstruction={epoch_ratio: 0}"])
+    with pytest.raises(ValueError, match=r"ssl.full_reconstruction.targets: unknown observation group 'audio'"):
+        load_agent_config("bounce", overrides=["ssl.full_reconstruction={targets: [audio]}"])
+    cfg = load_agent_config("bounce", overrides=["ssl.forward_dynamics={}", "ssl.forward_dynamics.weight=0.5"])
+    assert list(cfg.ssl.enabled()) == ["forward_dynamics"] and cfg.ssl.forward_dynamics.weight == 0.5
+
+
+def test_aux_epochs_follow_roto_rule():
+    from roto.rl.ssl import aux_epochs
+
+    assert [aux_epochs(10, r) for r in (0.25, 0.5, 1.0, 0.01)] == [2, 5, 10, 1]
+    assert aux_epochs(7, 0.75) == 5

@@ -17,15 +17,26 @@ TINY = [
 ]
 
 
-def tiny_trainer(tmp_path, name, updates, **kwargs):
+def tiny_trainer(tmp_path, name, updates, extra=(), **kwargs):
     env = EnvConfig(task="bounce", robot="shadow", num_envs=4, seed=3)
     settings = TrainSettings(env=env, total_steps=16 * updates)
-    agent = load_agent_config("bounce", overrides=TINY)
+    agent = load_agent_config("bounce", overrides=[*TINY, *extra])
     return Trainer(settings, agent, tmp_path / name, tensorboard=False, **kwargs)
 
 
 def params(trainer):
     return {k: v.clone() for k, v in trainer.model.state_dict().items()}
+
+
+def same_nested(a, b):
+    """Exact equality of nested dicts / lists of tensors and plain values."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(same_nested(a[k], b[k]) for k in a)
+    if isinstance(a, list | tuple):
+        return len(a) == len(b) and all(same_nested(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, torch.Tensor):
+        return torch.equal(a, b)
+    return a == b
 
 
 def test_same_seed_gives_identical_parameters(tmp_path):
@@ -53,6 +64,45 @@ def test_resume_continues_bit_identically(tmp_path):
     assert (
         resumed.alg.optimizer.state_dict()["state"][0]["step"] == whole.alg.optimizer.state_dict()["state"][0]["step"]
     )
+
+
+AGENT_V2 = [
+    "ssl.forward_dynamics_memory={seq_length: 2, capacity: 40}",
+    "ssl.forward_dynamics={seq_length: 3, max_sequences: 6}",
+    "ssl.full_reconstruction={epoch_ratio: 0.5}",
+    "network.critic=[tactile, proprio, privileged]",
+    "run.eval_every=1",
+]
+
+
+def test_resume_is_bit_identical_with_auxiliary_losses_and_a_privileged_critic(tmp_path):
+    whole = tiny_trainer(tmp_path, "whole", 3, extra=AGENT_V2)
+    whole.train(progress=False)
+    tiny_trainer(tmp_path, "part", 2, extra=AGENT_V2).train(progress=False)
+    resumed = Trainer.resume(tmp_path / "part", total_steps=16 * 3, tensorboard=False)
+    resumed.train(progress=False)
+    assert all(torch.equal(a, b) for a, b in zip(params(whole).values(), params(resumed).values(), strict=True))
+    # EMA target encoders, heads, auxiliary optimisers and the sequence memory, exactly
+    assert same_nested(whole.alg.state_dict(), resumed.alg.state_dict())
+    memory_loss = next(aux for aux in resumed.alg.aux_losses if aux.name == "forward_dynamics_memory")
+    assert memory_loss.memory.count == 40  # 12 + 16 + 16 windows (the last two rollouts with the tail)
+    # the evaluations file holds each update once
+    from roto.rl.evaluation import read_evaluations
+
+    assert [r["update"] for r in read_evaluations(tmp_path / "part")] == [1, 2, 3]
+
+
+def test_resume_forgets_evaluations_recorded_after_its_checkpoint(tmp_path):
+    from roto.rl.evaluation import read_evaluations
+
+    tiny_trainer(tmp_path, "run", 3, extra=["run.eval_every=1", "run.checkpoint_every=2"]).train(progress=False)
+    (tmp_path / "run" / "checkpoints" / "latest.pt").unlink()
+    (tmp_path / "run" / "checkpoints" / "agent_2.pt").rename(tmp_path / "run" / "checkpoints" / "latest.pt")
+    resumed = Trainer.resume(tmp_path / "run", tensorboard=False)  # a crash after update 3's evaluation
+    assert resumed.update == 2
+    assert [r["update"] for r in read_evaluations(tmp_path / "run")] == [1, 2]
+    resumed.train(progress=False)
+    assert [r["update"] for r in read_evaluations(tmp_path / "run")] == [1, 2, 3]
 
 
 def test_resume_without_a_checkpoint_is_a_clear_error(tmp_path):
@@ -84,3 +134,39 @@ def test_ppo_learns_the_toy_task(tmp_path):
     last = trainer.train(progress=False)
     # random actions in [-1, 1] earn about 8 * (1 - 2/3) = 2.7 per 8-step episode; the optimum is 8
     assert last["eval/return_mean"] > 7.0, last
+
+
+class CountingToyEnv(ToyEnv):
+    """The toy env, counting its steps."""
+
+    def __init__(self, config):
+        super().__init__(config)
+        self.steps = 0
+
+    def step(self, action):
+        self.steps += 1
+        return super().step(action)
+
+
+def test_best_checkpoint_holds_exactly_the_weights_of_the_best_evaluation(tmp_path):
+    from roto.rl.checkpoints import load_checkpoint
+    from roto.rl.evaluation import read_evaluations
+
+    settings = TrainSettings(
+        env=EnvConfig(task="bounce", obs_mode="proprio", num_envs=8, seed=0), total_steps=8 * 8 * 6
+    )
+    overrides = [*TINY, "ppo.rollouts=8", "ppo.lr=3e-3", "run.num_eval_envs=5", "run.eval_every=1"]
+    trainer = Trainer(settings, load_agent_config("bounce", overrides=overrides), tmp_path / "toy", tensorboard=False,
+                      env_factory=CountingToyEnv)  # fmt: skip
+    trainer.train(progress=False)
+    records = read_evaluations(tmp_path / "toy")
+    assert [r["update"] for r in records] == [1, 2, 3, 4, 5, 6]
+    # evaluation envs step only while evaluating: one 8-step episode per evaluation
+    assert trainer.evaluator.env.steps == 6 * 8
+    best = max(records, key=lambda r: r["return_mean"])
+    state = load_checkpoint(tmp_path / "toy" / "checkpoints" / "best.pt")
+    assert state["update"] == best["update"]
+    # the saved weights, evaluated again on the same starts, give the recorded figures exactly
+    trainer.model.load_state_dict(state["model"])
+    again = trainer.evaluator.evaluate(trainer.model, update=-1)
+    assert again["per_episode"]["return"] == best["per_episode"]["return"]
