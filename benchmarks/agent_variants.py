@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import json
 import pathlib
+import statistics
 import subprocess
 import time
 
@@ -22,7 +23,7 @@ import torch
 
 from roto.envs.config import EnvConfig
 from roto.eval.evaluate import evaluate
-from roto.eval.plots import plot_variants
+from roto.eval.plots import plot_variants, read_scalars
 from roto.rl.config import load_agent_config
 from roto.rl.evaluation import read_evaluations
 from roto.rl.runner import CHECKPOINT_DIR, Trainer, TrainSettings, load_policy
@@ -40,7 +41,7 @@ VARIANTS = {
         "privileged_critic": ["network.critic=[tactile, proprio, privileged]"],
     },
     "baoding": {
-        "config": "baoding_cpu",
+        "config": "baoding",
         "ppo": [],
         "forward_dynamics_memory": ["ssl.forward_dynamics_memory={weight: 0.025, lr: 2.5e-4, seq_length: 2}"],
     },
@@ -48,6 +49,12 @@ VARIANTS = {
 """Per task: the base agent config (a packaged name) and each variant's overrides on top of it."""
 
 METRIC = {"bounce": "bounces", "baoding": "rotations"}
+
+
+def finished(run_dir: pathlib.Path, steps: int) -> bool:
+    """Whether the run's last evaluation was at the end of a ``steps`` budget."""
+    records = read_evaluations(run_dir)
+    return bool(records) and records[-1]["env_steps"] >= steps
 
 
 def train_one(task: str, variant: str, seed: int, args: argparse.Namespace) -> pathlib.Path:
@@ -82,12 +89,20 @@ def final_evaluations(run_dir: pathlib.Path, episodes: int) -> dict[str, dict]:
     return out
 
 
+def median_costs(run_dir: pathlib.Path) -> dict[str, float]:
+    """Median seconds per update of simulation, inference and the update, and env steps/s, over the run."""
+    series = read_scalars(run_dir)
+    tags = ("perf/simulation_s", "perf/inference_s", "perf/update_s", "perf/steps_per_s")
+    return {tag.removeprefix("perf/"): statistics.median(series[tag][1]) for tag in tags}
+
+
 def summarize_run(run_dir: pathlib.Path, episodes: int) -> dict:
     """What the results table needs of one run."""
     records = read_evaluations(run_dir)
     best = max(records, key=lambda r: r["return_mean"])
     return {
         "run_dir": str(run_dir),
+        "median_per_update": median_costs(run_dir),
         "train_wall_s": records[-1]["train_wall_s"],
         "env_steps": records[-1]["env_steps"],
         "best_update": best["update"],
@@ -110,6 +125,7 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=100)
     parser.add_argument("--runs", default="runs/variants")
     parser.add_argument("--out", default="benchmarks/results")
+    parser.add_argument("--report_only", action="store_true", help="train nothing; report the finished runs")
     args = parser.parse_args()
     torch.set_num_threads(args.torch_threads)
     variants = args.variants or [v for v in VARIANTS[args.task] if v != "config"]
@@ -117,7 +133,12 @@ def main() -> None:
     results: dict[str, list[dict]] = {}
     for seed in args.seeds:  # seed-major: every variant gets its first seed before any gets a second
         for variant in variants:
-            run_dir = train_one(args.task, variant, seed, args)
+            run_dir = pathlib.Path(args.runs) / args.task / variant / f"seed{seed}"
+            if not args.report_only:
+                train_one(args.task, variant, seed, args)
+            elif not finished(run_dir, args.steps):
+                print(f"{run_dir}: not finished, left out of the report", flush=True)
+                continue
             results.setdefault(variant, []).append(summarize_run(run_dir, args.episodes))
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
