@@ -18,16 +18,12 @@ import matplotlib.pyplot as plt
 
 from roto.eval.plots import read_scalars
 
+WINDOW = 10  # evaluation rounds in the running mean
+THRESHOLDS = (5, 10, 18, 25)  # running-mean levels whose first crossing the summary reports
 
-def main() -> None:
-    parser = argparse.ArgumentParser()
-    parser.add_argument("run_dir")
-    parser.add_argument("out")
-    parser.add_argument("--metric", default="bounces")
-    parser.add_argument("--title", default=None)
-    args = parser.parse_args()
-    series = read_scalars(args.run_dir)
-    steps, mean = series[f"eval/{args.metric}_mean"]
+
+def wall_time_at(series: dict[str, tuple[list[int], list[float]]]) -> dict[int, float]:
+    """{env steps: training wall seconds so far}, logged or summed from each update's throughput."""
     if "perf/train_wall_s" in series:
         wall_steps, wall = series["perf/train_wall_s"]
     else:
@@ -37,12 +33,22 @@ def main() -> None:
         for rate in sps:
             total += per_update / rate
             wall.append(total)
-    wall_at = dict(zip(wall_steps, wall, strict=True))
-    fig, ax = plt.subplots(figsize=(7, 4))
-    window = 10
-    smooth = [
-        sum(mean[max(0, i - window + 1) : i + 1]) / len(mean[max(0, i - window + 1) : i + 1]) for i in range(len(mean))
+    return dict(zip(wall_steps, wall, strict=True))
+
+
+def running_mean(values: list[float], window: int) -> list[float]:
+    """Mean of each value and the up to ``window - 1`` before it."""
+    return [
+        sum(values[max(0, i - window + 1) : i + 1]) / len(values[max(0, i - window + 1) : i + 1])
+        for i in range(len(values))
     ]
+
+
+def draw(
+    args: argparse.Namespace, steps: list[int], mean: list[float], smooth: list[float], wall_at: dict[int, float]
+) -> None:
+    """The curve against env steps, with wall-time ticks on top, saved to ``args.out``."""
+    fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(
         steps,
         mean,
@@ -51,7 +57,7 @@ def main() -> None:
         lw=0.8,
         label=f"each evaluation round ({args.metric}, mean of its episodes)",
     )
-    ax.plot(steps, smooth, color="tab:blue", lw=2, label=f"running mean of {window} rounds")
+    ax.plot(steps, smooth, color="tab:blue", lw=2, label=f"running mean of {WINDOW} rounds")
     ax.set_xlabel("env steps")
     ax.set_ylabel(f"{args.metric} per 10 s episode")
     ax.grid(alpha=0.3)
@@ -65,6 +71,10 @@ def main() -> None:
         ax.set_title(args.title, fontsize=10, pad=30)
     fig.tight_layout()
     fig.savefig(args.out, dpi=110)
+
+
+def summarize(steps: list[int], mean: list[float], smooth: list[float], wall_at: dict[int, float]) -> dict:
+    """Last / best evaluation, wall time at the last one, and first crossings of the running mean."""
     best = max(range(len(mean)), key=mean.__getitem__)
     summary = {
         "evaluations": len(mean),
@@ -77,11 +87,26 @@ def main() -> None:
     summary["last_running_mean"] = smooth[-1]
     summary["best_running_mean"] = max(smooth)
     first_over = {}
-    for threshold in (5, 10, 18, 25):
+    for threshold in THRESHOLDS:
         hit = next((s for s, m in zip(steps, smooth, strict=True) if m >= threshold), None)
         first_over[threshold] = hit
     summary["first_env_steps_running_mean_at_or_above"] = first_over
-    print(json.dumps(summary))
+    return summary
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("run_dir")
+    parser.add_argument("out")
+    parser.add_argument("--metric", default="bounces")
+    parser.add_argument("--title", default=None)
+    args = parser.parse_args()
+    series = read_scalars(args.run_dir)
+    steps, mean = series[f"eval/{args.metric}_mean"]
+    wall_at = wall_time_at(series)
+    smooth = running_mean(mean, WINDOW)
+    draw(args, steps, mean, smooth, wall_at)
+    print(json.dumps(summarize(steps, mean, smooth, wall_at)))
 
 
 if __name__ == "__main__":

@@ -144,11 +144,7 @@ def _cmd_render(args: argparse.Namespace) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``roto`` argument parser."""
-    parser = argparse.ArgumentParser(prog="roto", description="roto: the Robot Tactile Olympiad on MuJoCo")
-    sub = parser.add_subparsers(dest="command", required=True)
-
+def _add_train_parser(sub: argparse._SubParsersAction) -> None:
     p_train = sub.add_parser(
         "train", help="train roto's PPO agent, optionally with auxiliary losses (progress bar, logs, checkpoints)"
     )
@@ -183,6 +179,8 @@ def build_parser() -> argparse.ArgumentParser:
     p_train.add_argument("overrides", nargs="*", metavar="section.key=value", help="agent config overrides")
     p_train.set_defaults(func=_cmd_train)
 
+
+def _add_eval_parser(sub: argparse._SubParsersAction) -> None:
     p_eval = sub.add_parser("eval", help="evaluate a checkpoint over full episodes (deterministic policy)")
     p_eval.add_argument("--checkpoint", required=True)
     p_eval.add_argument("--episodes", type=int, default=100)
@@ -190,6 +188,8 @@ def build_parser() -> argparse.ArgumentParser:
     p_eval.add_argument("--out", default=None, help="JSON path (default: next to the checkpoint)")
     p_eval.set_defaults(func=_cmd_eval)
 
+
+def _add_play_parser(sub: argparse._SubParsersAction) -> None:
     p_play = sub.add_parser("play", help="render a checkpoint's policy offscreen into an mp4")
     p_play.add_argument("--checkpoint", required=True)
     p_play.add_argument("--video", default="videos/play.mp4", help="mp4 path (default: videos/play.mp4)")
@@ -198,6 +198,8 @@ def build_parser() -> argparse.ArgumentParser:
     p_play.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; always headless")
     p_play.set_defaults(func=_cmd_play)
 
+
+def _add_render_parser(sub: argparse._SubParsersAction) -> None:
     p_render = sub.add_parser("render", help="a PNG of a hand in a task scene (offscreen, no display needed)")
     p_render.add_argument("--task", default="bounce")
     p_render.add_argument("--robot", default="shadow")
@@ -206,9 +208,13 @@ def build_parser() -> argparse.ArgumentParser:
     p_render.add_argument("--seed", type=int, default=0)
     p_render.set_defaults(func=_cmd_render)
 
+
+def _add_list_parser(sub: argparse._SubParsersAction) -> None:
     p_list = sub.add_parser("list", help="every (task, robot) pair with its observation and action sizes")
     p_list.set_defaults(func=_cmd_list)
 
+
+def _add_bench_parser(sub: argparse._SubParsersAction) -> None:
     p_bench = sub.add_parser("bench", help="env throughput vs plain physics stepping of the same model")
     _add_env_args(p_bench, num_envs=256)
     p_bench.add_argument("--steps", type=int, default=200, help="timed control steps (default: 200)")
@@ -216,10 +222,29 @@ def build_parser() -> argparse.ArgumentParser:
     p_bench.add_argument("--json", action="store_true", help="print one JSON object")
     p_bench.set_defaults(func=_cmd_bench)
 
+
+def _add_demo_parser(sub: argparse._SubParsersAction) -> None:
     p_demo = sub.add_parser("demo", help="run the scripted Bounce policy and print its bounces per episode")
     _add_env_args(p_demo, num_envs=8)
     p_demo.add_argument("--episodes", type=int, default=1, help="episodes per env (default: 1)")
     p_demo.set_defaults(func=_cmd_demo)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``roto`` argument parser."""
+    parser = argparse.ArgumentParser(prog="roto", description="roto: the Robot Tactile Olympiad on MuJoCo")
+    sub = parser.add_subparsers(dest="command", required=True)
+    # the order here is the order ``roto --help`` lists the subcommands in
+    for add in (
+        _add_train_parser,
+        _add_eval_parser,
+        _add_play_parser,
+        _add_render_parser,
+        _add_list_parser,
+        _add_bench_parser,
+        _add_demo_parser,
+    ):
+        add(sub)
     return parser
 
 

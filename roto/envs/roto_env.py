@@ -172,10 +172,7 @@ class RotoEnv:
 
     def state_dict(self) -> dict[str, Any]:
         """Everything that decides the env's future: physics, task counters, frame stack, RNG, pooled starts.
-
-        ``load_state_dict`` of it on an env built from the same config continues bit-identically
-        (what exact training resume relies on).
-        """
+        ``load_state_dict`` of it on an env built from the same config continues bit-identically (exact resume)."""
         return {
             "physics": torch.from_numpy(self.backend.physics_state()),
             "task": {f.name: getattr(self.task_state, f.name).clone() for f in dataclasses.fields(self.task_state)},
