@@ -123,3 +123,15 @@ def test_train_records_evaluations_and_draws_the_learning_curve(trained_run, tmp
     out = plot_learning_curve(trained_run, tmp_path / "curve.png")
     assert out is not None and out.stat().st_size > 1000
     assert plot_learning_curve(tmp_path) is None  # no evaluations: no figure
+
+
+def test_a_privileged_critic_run_evaluates_and_plays_with_its_blind_policy(tmp_path, capsys):
+    run_dir = tmp_path / "priv"
+    overrides = [*TINY, "network.critic=[tactile, proprio, privileged]", "ssl.forward_dynamics={seq_length: 2}"]
+    assert (
+        main(["train", "--num_envs", "4", "--steps", "16", "--run_dir", str(run_dir), "--no_progress", *overrides]) == 0
+    )
+    ckpt = run_dir / "checkpoints" / "best.pt"
+    assert main(["eval", "--checkpoint", str(ckpt), "--episodes", "2", "--out", str(tmp_path / "e.json")]) == 0
+    assert json.loads(capsys.readouterr().out.strip().splitlines()[-1])["episodes"] == 2
+    assert main(["play", "--checkpoint", str(ckpt), "--video", str(tmp_path / "p.mp4"), "--video_length", "5"]) == 0

@@ -51,8 +51,9 @@ class PPO:
         self.aux_losses = list(aux_losses or [])
         self.optimizer = torch.optim.Adam(model.parameters(), lr=config.lr)
         self.lr = config.lr
-        self.value_scaler = RunningStandardScaler(1, clip=None) if config.value_normalization else None
-        self.value_scaler = self.value_scaler.to(storage.values.device) if self.value_scaler is not None else None
+        self.value_scaler = None
+        if config.value_normalization:
+            self.value_scaler = RunningStandardScaler(1, clip=None).to(storage.values.device)
         self._step: dict[str, Any] = {}
 
     # -------------------------------------------------------------- values in return units
