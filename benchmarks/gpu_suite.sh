@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Every GPU figure of the Warp backend, in one sitting (one call of a lent GPU machine; see
+# Every GPU figure of the Warp backend in one command (one call of a lent GPU machine; see
 # docs/backends.md for how the packages get there).
 #   usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS]
 # Writes OUT_DIR/gpu.txt, OUT_DIR/bench_warp.jsonl (one line per (task, robot) pair) and, if
 # TRAIN_SECONDS > 0, a blind Shadow Bounce training run OUT_DIR/train_bounce_shadow/ cut off after
-# that many seconds (its scalars.csv holds the evaluation curve and perf/steps_per_s).
+# that many seconds (its scalars.csv holds perf/steps_per_s, its evaluations.jsonl the evaluation curve).
 set -uo pipefail
 out=${1:?usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS]}
 train_s=${2:-0}
