@@ -87,6 +87,13 @@ class FrameStack:
             else:
                 self._frames[name][env_ids] = copies
 
+    def reset_where(self, frame: dict[str, torch.Tensor], mask: torch.Tensor) -> None:
+        """Fill the stacks of the worlds where ``mask`` (B,) bool is True with k copies of their
+        rows of ``frame`` ((B, dim) per group); no host read."""
+        rows = mask[:, None]
+        for name, value in frame.items():
+            self._frames[name] = torch.where(rows, value.repeat(1, self.k), self._frames[name])
+
     def push(self, frame: dict[str, torch.Tensor]) -> None:
         """Append one frame ((B, dim) per group), dropping the oldest."""
         for name, value in frame.items():

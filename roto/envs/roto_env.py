@@ -19,15 +19,16 @@ import numpy as np
 import torch
 
 from roto.envs.capacity import warp_capacity
-from roto.envs.columns import Columns
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
+from roto.envs.indices import SceneIndices
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
 from roto.envs.start_pool import StartPool
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
 from roto.sim.backend import make_backend
-from roto.sim.scene import SceneLayout, build_scene
+from roto.sim.host_sync import deliberate_host_sync
+from roto.sim.scene import build_scene
 from roto.tasks import get_task
 from roto.tasks.base import TaskInputs, uniform
 
@@ -38,6 +39,10 @@ def resolve_device(device: str | torch.device) -> torch.device:
     if device.type == "cuda" and device.index is None:
         return torch.device("cuda", torch.cuda.current_device())
     return device
+
+
+DEVICE_CHECK_EVERY = 16
+"""Steps between the host reads of a GPU env (pool of starts, action finiteness)."""
 
 
 @dataclass
@@ -76,7 +81,7 @@ class RotoEnv:
         )
         self._generator = torch.Generator(device=self.device)
         self._generator.manual_seed(config.seed)
-        self._idx = _Indices.from_layout(self.layout, self.robot, self.model, self.device)
+        self._idx = SceneIndices.from_layout(self.layout, self.robot, self.model, self.device)
         self.num_actions = self.robot.num_actions
         self.task_state = self.task.init_state(self.robot, self.num_envs, self.device)
         self._stack = FrameStack(config.frame_stack)
@@ -87,9 +92,17 @@ class RotoEnv:
         self._target = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
         self._last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
         self._zero_qvel = torch.zeros(self.num_envs, self.model.nv, dtype=torch.float64, device=self.device)
-        self._starts = StartPool(self._draw_starts, size=self.num_envs)
+        self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
+        # reading the device is free on the CPU and waits for a GPU. A sync-free step reads nothing:
+        # resets run masked every step, and the pool of starts and the action check are read every
+        # `check_every` steps, the pool holding enough starts for every world to reset on each of
+        # them (tests switch this on for a CPU env to check it against the CPU path)
+        self.sync_free_step = self.device.type != "cpu"
+        self.check_every = DEVICE_CHECK_EVERY if self.sync_free_step else 1
+        self._since_check = 0
+        self._actions_finite = torch.ones((), dtype=torch.bool, device=self.device)
         self._needs_reset = True
         self.frame_sizes = self._frame_sizes()
         self.observation_space = gym.spaces.Dict(
@@ -107,8 +120,9 @@ class RotoEnv:
         if seed is not None:
             self._generator.manual_seed(int(seed))
         self._starts.clear()  # a reset, seeded or not, starts from freshly drawn starts
-        all_ids = torch.arange(self.num_envs, device=self.device)
-        frame = self._reset_worlds(all_ids)
+        self._starts.ensure(self.check_every * self.num_envs)
+        self._since_check = 0
+        frame = self._reset_where(torch.ones(self.num_envs, dtype=torch.bool, device=self.device))
         self._stack.reset(frame)
         self._needs_reset = False
         return self._stack.observation(), {}
@@ -155,15 +169,20 @@ class RotoEnv:
 
         done = terminated | truncated
         info: dict[str, Any] = {"reward_terms": result.reward_terms, "nonfinite": diverged}
-        done_ids = torch.nonzero(done).flatten()  # the step's one read-back after physics (reset count)
-        if len(done_ids):
+        # a step without resets skips them, unless asking would wait for the device: then the reset
+        # runs every step, masked (a world that did not finish is left as it was)
+        any_done = True if self.sync_free_step else self._ensure_starts(done)
+        if any_done:
             info["final_obs"] = obs
             info["_final_obs"] = done
             info["episode"] = self._episode_info(truncated)
             info["_episode"] = done
             self._nonfinite_resets += diverged.sum()  # stays on the device until someone reads it
-            self._stack.reset(self._reset_worlds(done_ids), done_ids)
+            self._stack.reset_where(self._reset_where(done), done)
             obs = self._stack.observation()
+        self._since_check += 1
+        if self._since_check == self.check_every:
+            self._periodic_check()
         return obs, reward.to(torch.float32), terminated, truncated, info
 
     def close(self) -> None:
@@ -206,6 +225,9 @@ class RotoEnv:
             self._starts.clear()
         self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
+        if not self._needs_reset:  # the pool covers the steps until the next check (same draws, earlier)
+            self._starts.ensure(self.check_every * self.num_envs)
+        self._since_check = 0
 
     @property
     def nonfinite_resets(self) -> int:
@@ -245,6 +267,9 @@ class RotoEnv:
             raise TypeError(f"action dtype {action.dtype} is not floating point; use torch.float32 or torch.float64")
         if action.device != self.device:
             raise ValueError(f"action is on device {action.device}; this env runs on {self.device}")
+        if self.sync_free_step:  # read every `check_every` steps (_periodic_check)
+            self._actions_finite &= torch.isfinite(action).all()
+            return action
         # one reduction instead of an element-wise check: a NaN or inf anywhere makes the sum
         # non-finite; a sum that overflowed from finite values is told apart by the full check
         if not math.isfinite(float(action.sum())):
@@ -254,6 +279,28 @@ class RotoEnv:
                     f"action has non-finite values (NaN or inf) in envs {bad[:10]}; actions must be finite"
                 )
         return action
+
+    def _ensure_starts(self, done: torch.Tensor) -> bool:
+        """Make this step's resets available in the pool; whether any world finished (a host read)."""
+        count = int(done.sum())
+        self._starts.ensure(count)
+        return count > 0
+
+    def _periodic_check(self) -> None:
+        """Every ``check_every`` steps (each step on the CPU): top the pool of starts up for the next
+        ``check_every`` steps and raise on a non-finite action since the last check (on a GPU the
+        action check cannot stop the step it happens in without waiting for the device)."""
+        self._since_check = 0
+        if not self.sync_free_step:
+            return
+        with deliberate_host_sync(self.device):
+            self._starts.ensure(self.check_every * self.num_envs)
+            if not bool(self._actions_finite):
+                self._actions_finite.fill_(True)
+                raise ValueError(
+                    f"an action had non-finite values (NaN or inf) in the last {self.check_every} steps; "
+                    "actions must be finite (on a GPU they are checked every few steps, not before each one)"
+                )
 
     def _task_inputs(self, qpos: torch.Tensor, qvel: torch.Tensor, sensors: torch.Tensor) -> TaskInputs:
         idx = self._idx
@@ -293,17 +340,20 @@ class RotoEnv:
             )
         return {name: groups[name] for name in self.groups}
 
-    def _reset_worlds(self, env_ids: torch.Tensor) -> dict[str, torch.Tensor]:
-        """Start new episodes in worlds ``env_ids`` from the next pooled starts; their first frame."""
-        start = self._starts.take(len(env_ids))
-        self.backend.set_state(env_ids, start["qpos"], self._zero_qvel[: len(env_ids)])
-        self.task.reset(self.task_state, env_ids)
-        self._target[env_ids] = start["target"]
-        self._last_action.index_fill_(0, env_ids, 0.0)
-        self._episode.length.index_fill_(0, env_ids, 0)
-        self._episode.ret.index_fill_(0, env_ids, 0.0)
+    def _reset_where(self, done: torch.Tensor) -> dict[str, torch.Tensor]:
+        """Start new episodes in the worlds where ``done`` (B,) is True from the next pooled starts,
+        in world order; returns a (B, dim) frame per group whose ``done`` rows are their first frames.
+        Fixed shapes throughout: nothing is read back from the device."""
+        start = self._starts.take_where(done)
+        rows = done[:, None]
+        self.backend.set_state_where(done, start["qpos"], self._zero_qvel)
+        self.task.reset(self.task_state, done)
+        self._target = torch.where(rows, start["target"], self._target)
+        self._last_action.masked_fill_(rows, 0.0)
+        self._episode.length.masked_fill_(done, 0)
+        self._episode.ret.masked_fill_(done, 0.0)
         for value in self._term_sums.values():
-            value.index_fill_(0, env_ids, 0.0)
+            value.masked_fill_(done, 0.0)
         return {name: start[f"frame/{name}"] for name in self.groups}
 
     def _draw_starts(self, n: int) -> dict[str, torch.Tensor]:
@@ -337,64 +387,3 @@ class RotoEnv:
         info.update({k: v.clone() for k, v in self.task.metrics(self.task_state).items()})
         info.update({f"reward/{k}": v.to(torch.float32, copy=True) for k, v in self._term_sums.items()})
         return info
-
-
-@dataclass(frozen=True)
-class _Indices:
-    """Column selections of qpos / qvel / sensordata and constants, on the env's device."""
-
-    act_qpos: Columns
-    obs_qpos: Columns
-    obs_qvel: Columns
-    obs_lo: torch.Tensor
-    obs_hi: torch.Tensor
-    ctrl_lo: torch.Tensor
-    ctrl_hi: torch.Tensor
-    ball_pos: Columns  # (n_ball, 3) qpos indices of each ball's centre
-    ball_vel: Columns  # (n_ball, 3) qvel indices of each ball's linear velocity
-    tactile_force: Columns  # (n_links,) sensordata index of each link's normal force
-    ball_force: Columns  # (n_ball,) sensordata index of each ball-hand normal force
-    default_qpos: torch.Tensor  # (1, nq), the balls' quaternions at identity
-    coupled_driven: Columns
-    coupled_driver: Columns
-    coupled_ratio: torch.Tensor
-    coupled_lo: torch.Tensor
-    coupled_hi: torch.Tensor
-
-    @classmethod
-    def from_layout(cls, layout: SceneLayout, robot: RobotSpec, model: Any, device: torch.device) -> _Indices:
-        def t(array: Any, dtype: torch.dtype = torch.int64) -> torch.Tensor:
-            return torch.as_tensor(np.asarray(array), dtype=dtype, device=device)
-
-        def c(array: Any) -> Columns:
-            return Columns.of(array, device)
-
-        f64 = torch.float64
-        driven = [model.joint(j).qposadr[0] for j in robot.coupled_joints]
-        driver = [model.joint(d).qposadr[0] for d, _ in robot.coupled_joints.values()]
-        driven_ids = [model.joint(j).id for j in robot.coupled_joints]
-        default = layout.default_qpos.copy()
-        default[layout.ball_qpos[:, None] + 3 + np.arange(4)] = [1.0, 0.0, 0.0, 0.0]  # every reset starts unrotated
-        for j, (d, ratio) in robot.coupled_joints.items():
-            default[model.joint(j).qposadr[0]] = np.clip(
-                ratio * default[model.joint(d).qposadr[0]], *model.jnt_range[model.joint(j).id]
-            )
-        return cls(
-            act_qpos=c(layout.act_qpos),
-            obs_qpos=c(layout.obs_qpos),
-            obs_qvel=c(layout.obs_qvel),
-            obs_lo=t(layout.obs_lo, f64),
-            obs_hi=t(layout.obs_hi, f64),
-            ctrl_lo=t(layout.ctrl_lo, f64),
-            ctrl_hi=t(layout.ctrl_hi, f64),
-            ball_pos=c(layout.ball_qpos[:, None] + np.arange(3)),
-            ball_vel=c(layout.ball_qvel[:, None] + np.arange(3)),
-            tactile_force=c(layout.tactile_sensor + 1),
-            ball_force=c(layout.ball_contact_sensor + 1),
-            default_qpos=t(default, f64)[None],
-            coupled_driven=c(driven),
-            coupled_driver=c(driver),
-            coupled_ratio=t([r for _, r in robot.coupled_joints.values()], f64),
-            coupled_lo=t(model.jnt_range[driven_ids, 0] if driven_ids else [], f64),
-            coupled_hi=t(model.jnt_range[driven_ids, 1] if driven_ids else [], f64),
-        )

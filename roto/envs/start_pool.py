@@ -7,6 +7,12 @@ random actions) paid that evaluation, and some sixty small torch ops, on every s
 ``size`` starts in one batch (one batched sensor evaluation, spread over all threads or GPU worlds)
 and each reset then only copies rows.
 
+Handing starts out reads nothing back from the device: ``take_where`` gathers one row per world by
+the rank of each resetting world among this step's resets and advances a cursor that lives on the
+device. Only ``ensure`` (drawing more when fewer than needed are left) reads the cursor, so the env
+calls it where a host read is free (the CPU) or only every few steps, asking for enough starts to
+cover every world resetting on every step until the next call.
+
 The starts are drawn from the env's generator in pool order, so a seed still fixes every episode
 start; the draws are the same distribution as drawing per reset, only their order in the random
 stream differs.
@@ -23,42 +29,64 @@ Starts = dict[str, torch.Tensor]
 
 
 class StartPool:
-    """A FIFO of episode starts, refilled ``size`` at a time by ``draw(size)``."""
+    """A FIFO of episode starts, refilled ``size`` at a time by ``draw(size)``, on ``device``."""
 
-    def __init__(self, draw: Callable[[int], Starts], size: int) -> None:
+    def __init__(self, draw: Callable[[int], Starts], size: int, device: torch.device | str = "cpu") -> None:
         if size < 1:
             raise ValueError(f"start pool size must be >= 1, got {size}")
         self.size = size
         self._draw = draw
         self._rows: Starts = {}
-        self._next = 0
+        self._next = torch.zeros((), dtype=torch.int64, device=device)  # first row not yet handed out
 
     @property
     def remaining(self) -> int:
-        """Starts drawn and not yet handed out."""
+        """Starts drawn and not yet handed out (reading it waits for the device)."""
         if not self._rows:
             return 0
-        return len(next(iter(self._rows.values()))) - self._next
+        left = len(next(iter(self._rows.values()))) - int(self._next)
+        if left < 0:  # only a caller that skipped ``ensure`` can get here
+            raise RuntimeError(f"the start pool handed out {-left} starts it did not have; call ensure() first")
+        return left
 
-    def take(self, n: int) -> Starts:
-        """The next ``n`` starts, (n, ...) per name; draws ``size`` more first where fewer are left."""
+    def ensure(self, n: int) -> None:
+        """Make at least ``n`` starts available, drawing ``size`` more at a time (a host read)."""
         while self.remaining < n:
             fresh = self._draw(self.size)
             if self.remaining:
-                fresh = {name: torch.cat([rows[self._next :], fresh[name]]) for name, rows in self._rows.items()}
-            self._rows, self._next = fresh, 0
-        start, self._next = self._next, self._next + n
-        return {name: rows[start : self._next] for name, rows in self._rows.items()}
+                first = int(self._next)
+                fresh = {name: torch.cat([rows[first:], fresh[name]]) for name, rows in self._rows.items()}
+            self._rows = fresh
+            self._next.zero_()
+
+    def take(self, n: int) -> Starts:
+        """The next ``n`` starts, (n, ...) per name (draws more first where fewer are left)."""
+        self.ensure(n)
+        first = int(self._next)
+        self._next += n
+        return {name: rows[first : first + n] for name, rows in self._rows.items()}
+
+    def take_where(self, mask: torch.Tensor) -> Starts:
+        """One row per world, (B, ...) per name: world i with ``mask[i]`` gets the next start in
+        world order; the rows of the other worlds are arbitrary. Reads nothing back; the caller
+        has ensured ``mask.sum()`` starts beforehand."""
+        rank = torch.cumsum(mask, 0) - 1  # (B,) position of each masked world among them
+        last = len(next(iter(self._rows.values()))) - 1
+        rows = (self._next + rank).clamp_(0, last)
+        self._next += mask.sum()
+        return {name: value.index_select(0, rows) for name, value in self._rows.items()}
 
     def clear(self) -> None:
         """Drop every start drawn so far."""
-        self._rows, self._next = {}, 0
+        self._rows = {}
+        self._next.zero_()
 
     def state_dict(self) -> dict[str, Starts]:
         """Copies of the starts not yet handed out."""
-        return {"rows": {name: rows[self._next :].clone() for name, rows in self._rows.items()}}
+        first = int(self._next)
+        return {"rows": {name: rows[first:].clone() for name, rows in self._rows.items()}}
 
     def load_state_dict(self, state: dict[str, Starts], device: torch.device) -> None:
         """Restore what ``state_dict`` returned."""
         self._rows = {name: rows.clone().to(device) for name, rows in state["rows"].items()}
-        self._next = 0
+        self._next = torch.zeros((), dtype=torch.int64, device=device)

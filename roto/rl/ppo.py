@@ -77,7 +77,7 @@ class PPO:
         mean, log_std, value, _ = self.model(obs)
         std = log_std.exp().expand_as(mean)
         action = mean + std * torch.randn(mean.shape, generator=self.generator, device=mean.device)
-        log_prob = torch.distributions.Normal(mean, std).log_prob(action).sum(-1)
+        log_prob = torch.distributions.Normal(mean, std, validate_args=False).log_prob(action).sum(-1)
         self._step = {"obs": obs, "action": action, "log_prob": log_prob, "value": self.values(value)}
         return action
 
@@ -144,7 +144,7 @@ class PPO:
         """One backward of the weighted loss terms, PPO's Adam step, then each active loss's own step."""
         c = self.config
         mean, log_std, value, latent = self.model(batch["obs"])
-        dist = torch.distributions.Normal(mean, log_std.exp().expand_as(mean))
+        dist = torch.distributions.Normal(mean, log_std.exp().expand_as(mean), validate_args=False)
         terms, diagnostics = ppo_terms(
             dist.log_prob(batch["actions"]).sum(-1),
             batch["log_probs"],

@@ -44,6 +44,11 @@ class Backend(Protocol):
         """Overwrite the given worlds' state (n,) with ``qpos`` (n, nq), ``qvel`` (n, nv), time 0."""
         ...
 
+    def set_state_where(self, mask: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor) -> None:
+        """Overwrite the worlds where ``mask`` (B,) bool is True with their rows of ``qpos`` (B, nq)
+        and ``qvel`` (B, nv), time 0; the other rows are ignored."""
+        ...
+
     def sensors_at(self, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor) -> torch.Tensor:
         """Sensordata (n, nsensordata) at the states ``qpos`` (n, nq), ``qvel`` (n, nv) under ``ctrl``
         (n, nu), evaluated as a step from them would; no world changes."""

@@ -86,6 +86,13 @@ class MujocoCpuBackend:
         self.state[ids, self._qpos0 : self._qpos0 + self.model.nq] = qpos.cpu().to(torch.float64).numpy()
         self.state[ids, self._qvel0 : self._qvel0 + self.model.nv] = qvel.cpu().to(torch.float64).numpy()
 
+    def set_state_where(self, mask: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor) -> None:
+        """Overwrite the worlds where ``mask`` (B,) bool is True with their rows of ``qpos`` (B, nq)
+        and ``qvel`` (B, nv), time 0 (the state lives on the host, so the mask is read here)."""
+        ids = torch.nonzero(mask.cpu()).flatten()
+        if len(ids):
+            self.set_state(ids, qpos.cpu()[ids], qvel.cpu()[ids])
+
     def sensors_at(self, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor) -> torch.Tensor:
         """Sensordata (n, nsensordata) at the states ``qpos`` (n, nq), ``qvel`` (n, nv) under ``ctrl``
         (n, nu); no world changes.

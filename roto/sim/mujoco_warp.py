@@ -32,6 +32,7 @@ import numpy as np
 import torch
 
 from roto.sim.backend import SimState
+from roto.sim.host_sync import deliberate_host_sync
 
 MAX_VALUE = 1e10
 """MuJoCo's ``mjMAXVAL``: a |qpos| or |qvel| beyond it counts as diverged, as in MuJoCo C."""
@@ -172,10 +173,13 @@ class MujocoWarpBackend:
 
     def _capture_graphs(self) -> None:  # pragma: no cover - needs a GPU
         wp = self._wp
-        self._stream = wp.stream_from_torch(torch.cuda.current_stream(self.device))
+        # CUDA cannot capture on torch's default (legacy) stream: capture and replay on a stream of
+        # our own, ordered against torch's current stream by events (``_run``), never by a host wait
+        self._torch_stream = torch.cuda.Stream(self.device)
+        self._stream = wp.stream_from_torch(self._torch_stream)
+        saved = self.physics_state()  # a host copy: everything torch wrote so far is done
         with wp.ScopedDevice(self._wp_device), wp.ScopedStream(self._stream):
             # the first run compiles and loads every kernel; capture only the second
-            saved = self.physics_state()
             self._step_sequence()
             self._forward_sequence()
             with wp.ScopedCapture() as capture:
@@ -184,7 +188,8 @@ class MujocoWarpBackend:
             with wp.ScopedCapture() as capture:
                 self._forward_sequence()
             self._forward_graph = capture.graph
-            self.load_physics_state(saved)
+        wp.synchronize_device(self._wp_device)  # once, while building: the uncaptured runs are done
+        self.load_physics_state(saved)
 
     def _run(self, graph, sequence) -> None:
         wp = self._wp
@@ -192,8 +197,11 @@ class MujocoWarpBackend:
             with wp.ScopedDevice(self._wp_device):
                 sequence()
         else:  # pragma: no cover - needs a GPU
+            current = torch.cuda.current_stream(self.device)
+            self._torch_stream.wait_stream(current)  # the graph reads what torch wrote (ctrl, state)
             with wp.ScopedStream(self._stream):
                 wp.capture_launch(graph)
+            current.wait_stream(self._torch_stream)  # torch reads what the graph wrote
 
     # ------------------------------------------------------------------ Backend protocol
 
@@ -203,7 +211,8 @@ class MujocoWarpBackend:
         self._run(self._step_graph, self._step_sequence)
         self._steps += 1
         if self.overflow_check_every and self._steps % self.overflow_check_every == 0:
-            self.check_overflow()
+            with deliberate_host_sync(self.device):
+                self.check_overflow()
         # NaN and inf both fail "<= MAX_VALUE", so one comparison covers non-finite values too
         diverged = ~((self._qpos.abs() <= MAX_VALUE).all(dim=1) & (self._qvel.abs() <= MAX_VALUE).all(dim=1))
         return SimState(qpos=self._qpos, qvel=self._qvel, sensordata=self._sensors, diverged=diverged)
@@ -217,6 +226,15 @@ class MujocoWarpBackend:
         self._qpos[ids] = qpos.to(self.device, torch.float32)
         self._qvel[ids] = qvel.to(self.device, torch.float32)
         self._act[ids] = 0.0
+
+    def set_state_where(self, mask: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor) -> None:
+        """Overwrite the worlds where ``mask`` (B,) bool is True with their rows of ``qpos`` (B, nq)
+        and ``qvel`` (B, nv), time 0; fixed shapes, so nothing is read back from the device."""
+        rows = mask.to(self.device)[:, None]
+        self._time.masked_fill_(mask, 0.0)
+        self._qpos.copy_(torch.where(rows, qpos.to(self.device, torch.float32), self._qpos))
+        self._qvel.copy_(torch.where(rows, qvel.to(self.device, torch.float32), self._qvel))
+        self._act.masked_fill_(rows, 0.0)
 
     def sensors_at(self, qpos: torch.Tensor, qvel: torch.Tensor, ctrl: torch.Tensor) -> torch.Tensor:
         """Sensordata (n, nsensordata) at the states ``qpos`` (n, nq), ``qvel`` (n, nv) under ``ctrl``
@@ -292,6 +310,8 @@ class MujocoWarpBackend:
                 for _ in range(self.substeps):
                     mjw.step(self._m, d)
 
+            if self._step_graph is not None:  # pragma: no cover - needs a GPU
+                torch.cuda.synchronize(self.device)  # the copies above ran on torch's stream
             sequence()  # compile / load
             graph = None
             if self._step_graph is not None:  # pragma: no cover - needs a GPU

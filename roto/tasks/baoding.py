@@ -10,7 +10,7 @@ import torch
 
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
-from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, uniform
+from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, clear_where, uniform
 
 BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
@@ -109,10 +109,11 @@ class Baoding:
             swaps=torch.zeros(num_envs, dtype=torch.int64, device=device),
         )
 
-    def reset(self, state: BaodingState, env_ids: torch.Tensor) -> None:
-        """Clear the latches, swap count and assignment (ball a -> T_a, ball b -> T_b) of ``env_ids``."""
+    def reset(self, state: BaodingState, mask: torch.Tensor) -> None:
+        """Clear the latches, swap count and assignment (ball a -> T_a, ball b -> T_b) of the worlds
+        in ``mask`` (B,) bool."""
         for latch in (state.swapped, state.latched, state.swaps):
-            latch.index_fill_(0, env_ids, 0)
+            clear_where(latch, mask)
 
     def initial_ball_positions(self, state: BaodingState, n: int, generator: torch.Generator) -> torch.Tensor:
         """(n, 2, 3): ball a on T_b and ball b on T_a, plus one shared U(±5 mm)³ offset.

@@ -61,8 +61,8 @@ class Task(Protocol):
         """Fresh per-env task state (counters, latches)."""
         ...
 
-    def reset(self, state: object, env_ids: torch.Tensor) -> None:
-        """Clear the task state of ``env_ids`` (n,) for a new episode."""
+    def reset(self, state: object, mask: torch.Tensor) -> None:
+        """Clear the task state of the worlds where ``mask`` (B,) bool is True, for a new episode."""
         ...
 
     def initial_ball_positions(self, state: object, n: int, generator: torch.Generator) -> torch.Tensor:
@@ -83,3 +83,8 @@ def uniform(
 ) -> torch.Tensor:
     """U(-half_width, half_width) samples of ``shape`` drawn from ``generator``."""
     return (torch.rand(shape, generator=generator, device=device, dtype=torch.float64) * 2.0 - 1.0) * half_width
+
+
+def clear_where(values: torch.Tensor, mask: torch.Tensor) -> None:
+    """Zero, in place, the rows of ``values`` (B, ...) where ``mask`` (B,) bool is True."""
+    values.masked_fill_(mask.view(-1, *([1] * (values.dim() - 1))), 0)

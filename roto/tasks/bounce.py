@@ -8,7 +8,7 @@ import torch
 
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec
-from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, uniform
+from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, clear_where, uniform
 
 BALL = BallSpec(name="ball", radius=0.035, mass=0.030, friction=1.0)
 SPAWN_HEIGHT = 0.10
@@ -74,10 +74,10 @@ class Bounce:
         zeros_i = torch.zeros(num_envs, dtype=torch.int64, device=device)
         return BounceState(zeros_b, zeros_b.clone(), zeros_i, zeros_i.clone())
 
-    def reset(self, state: BounceState, env_ids: torch.Tensor) -> None:
-        """Clear the counters of ``env_ids``."""
+    def reset(self, state: BounceState, mask: torch.Tensor) -> None:
+        """Clear the counters of the worlds in ``mask`` (B,) bool."""
         for counter in (state.prev_contact, state.waiting, state.steps_without_contact, state.bounces):
-            counter.index_fill_(0, env_ids, 0)
+            clear_where(counter, mask)
 
     def initial_ball_positions(self, state: BounceState, n: int, generator: torch.Generator) -> torch.Tensor:
         """(n, 1, 3): the ball ~10 cm above the palm centre plus U(±1 cm) per axis."""

@@ -119,7 +119,7 @@ def test_checkpoint_saved_before_pooling_loads_and_draws_fresh_starts():
     assert env._starts.remaining == 0  # reset() used all four starts
     env._starts.take(1)  # leave leftovers that the load must drop
     env.load_state_dict(state)
-    assert env._starts.remaining == 0
+    assert env._starts.remaining == 4  # the leftovers dropped, B starts drawn afresh from the restored generator
     reference = make_env("bounce", num_envs=4, seed=3)
     reference.reset()
     reference._starts.clear()

@@ -64,7 +64,7 @@ def test_reset_clears_state_and_places_balls_on_the_other_target():
     state.swapped[:] = True
     state.latched[:] = True
     state.swaps[:] = 3
-    task.reset(state, torch.tensor([1]))
+    task.reset(state, torch.tensor([False, True]))
     pos = task.initial_ball_positions(state, 1, torch.Generator().manual_seed(0))
     assert state.swapped.tolist() == [True, False] and state.swaps.tolist() == [3, 0]
     assert state.latched.tolist() == [[True, True], [False, False]]

@@ -71,7 +71,7 @@ def test_reset_clears_counters_and_spawns_above_palm():
     state = task.init_state(get_robot("shadow"), 3, torch.device("cpu"))
     state.bounces[:] = 4
     state.waiting[:] = True
-    task.reset(state, torch.tensor([0, 2]))
+    task.reset(state, torch.tensor([True, False, True]))
     pos = task.initial_ball_positions(state, 2, torch.Generator().manual_seed(0))
     assert state.bounces.tolist() == [0, 4, 0] and state.waiting.tolist() == [False, True, False]
     assert pos.shape == (2, 1, 3)

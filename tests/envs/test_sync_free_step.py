@@ -1,0 +1,89 @@
+"""The sync-free step (what a GPU env runs: masked resets every step, host reads every few steps)
+against the CPU step it replaces, on the CPU where both can run; and, on a GPU, that the step never
+waits for the device."""
+
+import pytest
+import torch
+
+import roto
+from roto.registry import list_envs
+
+
+def rollout(env, steps: int, seed: int = 0) -> tuple[list[torch.Tensor], int]:
+    """Everything the env hands out over ``steps`` random-action steps, and how many episodes ended."""
+    generator = torch.Generator(device=env.device).manual_seed(seed)
+    obs, _ = env.reset(seed=seed)
+    seen, finished = [torch.cat([v.flatten() for v in obs.values()])], 0
+    for _ in range(steps):
+        action = torch.rand(env.num_envs, env.num_actions, generator=generator, device=env.device) * 2 - 1
+        obs, reward, terminated, truncated, info = env.step(action)
+        done = terminated | truncated
+        finished += int(done.sum())
+        seen += [torch.cat([v.flatten() for v in obs.values()]), reward, done.float()]
+        if "episode" in info and bool(info["_episode"].any()):  # a sync-free step always has the keys
+            mask = info["_episode"]
+            seen += [info["episode"]["r"][mask], info["final_obs"]["proprio"][mask].flatten()]
+    return seen, finished
+
+
+def sync_free(env, check_every: int):
+    env.sync_free_step, env.check_every = True, check_every
+    return env
+
+
+@pytest.mark.parametrize(("task", "robot"), [("bounce", "shadow"), ("baoding", "allegro")])
+def test_sync_free_step_is_bit_identical_to_the_cpu_step(task, robot):
+    reference = roto.make(task, robot=robot, num_envs=6, seed=1)
+    candidate = sync_free(roto.make(task, robot=robot, num_envs=6, seed=1), check_every=3)
+    (a, finished), (b, _) = rollout(reference, 150), rollout(candidate, 150)
+    assert finished > 5, "too few episodes ended: the masked reset went untested"
+    assert len(a) == len(b) and all(torch.equal(x, y) for x, y in zip(a, b, strict=True))
+
+
+def test_sync_free_step_reports_a_non_finite_action_at_the_next_check():
+    env = sync_free(roto.make("bounce", num_envs=2), check_every=3)
+    env.reset(seed=0)
+    bad = torch.zeros(2, env.num_actions)
+    bad[1, 0] = float("nan")
+    env.step(bad)  # not read yet
+    env.step(torch.zeros(2, env.num_actions))
+    with pytest.raises(ValueError, match=r"non-finite values \(NaN or inf\) in the last 3 steps"):
+        env.step(torch.zeros(2, env.num_actions))
+    env.step(torch.zeros(2, env.num_actions))  # the flag was cleared with the error
+
+
+def test_sync_free_state_dict_resumes_exactly():
+    whole = sync_free(roto.make("bounce", num_envs=4, seed=2), check_every=5)
+    rollout(whole, 40)
+    part = sync_free(roto.make("bounce", num_envs=4, seed=2), check_every=5)
+    rollout(part, 40)
+    resumed = sync_free(roto.make("bounce", num_envs=4, seed=2), check_every=5)
+    resumed.load_state_dict(part.state_dict())
+    action = torch.full((4, whole.num_actions), 0.3)
+    for _ in range(60):
+        a, b = whole.step(action), resumed.step(action)
+        assert all(torch.equal(a[0][k], b[0][k]) for k in a[0]) and torch.equal(a[1], b[1])
+
+
+cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="needs an NVIDIA GPU")
+
+
+@pytest.mark.gpu
+@cuda
+@pytest.mark.parametrize(("task", "robot"), [(t, r) for t, r in list_envs()])
+def test_gpu_step_never_waits_for_the_device(task, robot):
+    env = roto.make(task, robot=robot, num_envs=1024, backend="warp", device="cuda", seed=0)
+    env.reset(seed=0)
+    generator = torch.Generator(device="cuda").manual_seed(0)
+    finished = torch.zeros((), dtype=torch.int64, device="cuda")
+    torch.cuda.set_sync_debug_mode("error")  # any wait outside the periodic checks raises
+    try:
+        for _ in range(300):
+            action = torch.rand(1024, env.num_actions, generator=generator, device="cuda") * 2 - 1
+            obs, reward, terminated, truncated, _ = env.step(action)
+            finished += (terminated | truncated).sum()
+    finally:
+        torch.cuda.set_sync_debug_mode(0)
+    assert int(finished) > 0
+    assert all(bool(torch.isfinite(v).all()) for v in obs.values()) and bool(torch.isfinite(reward).all())
+    env.close()
