@@ -39,9 +39,9 @@ def first_episodes(
             done = info["_episode"]
             if on_done is not None:
                 on_done(done)
-            ids = torch.nonzero(done & (count < episodes_per_env)).flatten()
+            ids = torch.nonzero(done.cpu() & (count < episodes_per_env)).flatten()  # the tally lives on the host
             for name in names:
-                result[name][ids, count[ids]] = info["episode"][name][ids].to(torch.float64)
+                result[name][ids, count[ids]] = info["episode"][name].cpu()[ids].to(torch.float64)
             count[ids] += 1
             bar.update(len(ids))
     return result
