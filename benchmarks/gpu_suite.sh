@@ -1,27 +1,71 @@
 #!/usr/bin/env bash
-# Every GPU figure of the Warp backend in one command (one call of a lent GPU machine; see
-# docs/backends.md for how the packages get there).
+# Every GPU figure of the Warp backend in one command (one sitting of a GPU machine; docs/backends.md
+# says how to bring the packages to an offline one).
 #   usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS]
-# Writes OUT_DIR/gpu.txt, OUT_DIR/bench_warp.jsonl (one line per (task, robot) pair) and, if
-# TRAIN_SECONDS > 0, a blind Shadow Bounce training run OUT_DIR/train_bounce_shadow/ cut off after
-# that many seconds (its scalars.csv holds perf/steps_per_s, its evaluations.jsonl the evaluation curve).
+# Writes into OUT_DIR:
+#   gpu.txt           the GPU's name, memory and driver
+#   pytest_gpu.txt    `pytest -m gpu`: every pair stepped and a short training under sync-debug "error"
+#   bench_warp.jsonl  `roto bench` of all 8 (task, robot) pairs at NUM_ENVS (default 8192)
+#   scaling.jsonl     Shadow Bounce at 1k, 4k, 8k, 16k and 32k envs
+#   train_bounce_shadow/  if TRAIN_SECONDS > 0: blind Shadow Bounce at NUM_ENVS, stopped after that many
+#                     seconds (scalars.csv: perf/steps_per_s; evaluations.jsonl: the evaluation curve),
+#                     with policy_best.pt / policy_latest.pt (weights and settings only, for `roto eval`
+#                     and `roto play` elsewhere)
+#   suite.log         one line per step: exit status and seconds
+# Exits non-zero, naming the failed steps and the tail of their error output, if any step failed.
 set -uo pipefail
 out=${1:?usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS]}
 train_s=${2:-0}
 num_envs=${3:-8192}
 export ROTO_WARP_CACHE=${ROTO_WARP_CACHE:-/tmp/roto-warp-cache}
 mkdir -p "$out"
-nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv > "$out/gpu.txt" 2>&1
-for task in baoding bounce; do
+failed=()
+
+step() {  # step NAME STDOUT_FILE COMMAND...: run it, log status and time, remember a failure
+  local name=$1 stdout=$2 start status
+  shift 2
+  start=$(date +%s)
+  "$@" >> "$stdout" 2>> "$out/$name.err"
+  status=$?
+  echo "$name: exit $status, $(( $(date +%s) - start )) s" | tee -a "$out/suite.log"
+  if [ "$status" -ne 0 ]; then failed+=("$name"); fi
+}
+
+nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv > "$out/gpu.txt" 2>&1 || failed+=(nvidia-smi)
+step pytest_gpu "$out/pytest_gpu.txt" python3 -m pytest -q -m gpu -p no:cacheprovider \
+  tests/envs/test_sync_free_step.py tests/rl/test_training_gpu.py
+for task in bounce baoding; do
   for robot in shadow shadow_lite allegro orca; do
-    python3 -m roto.cli bench --backend warp --device cuda --task "$task" --robot "$robot" \
-      --num_envs "$num_envs" --steps 200 --json >> "$out/bench_warp.jsonl" 2>> "$out/bench_warp.err"
+    step "bench_${task}_${robot}" "$out/bench_warp.jsonl" python3 -m roto.cli bench --backend warp --device cuda \
+      --task "$task" --robot "$robot" --num_envs "$num_envs" --steps 200 --json
   done
 done
+for n in 1024 4096 8192 16384 32768; do
+  step "scaling_$n" "$out/scaling.jsonl" python3 -m roto.cli bench --backend warp --device cuda \
+    --task bounce --robot shadow --num_envs "$n" --steps 200 --json
+done
 if [ "$train_s" -gt 0 ]; then
+  run="$out/train_bounce_shadow"
+  # SIGINT at the time limit ends the run like Ctrl-C (exit 124 from timeout is the expected end)
   timeout --signal=INT "$train_s" python3 -m roto.cli train --backend warp --device cuda --task bounce \
-    --robot shadow --obs blind --num_envs "$num_envs" --steps 200000000 --seed 0 \
-    --run_dir "$out/train_bounce_shadow" --no_progress > "$out/train.log" 2>&1
-  rm -f "$out"/train_bounce_shadow/checkpoints/agent_*.pt  # keep latest/best only (transfer size)
+    --robot shadow --obs blind --num_envs "$num_envs" --steps 200000000 --seed 0 --run_dir "$run" \
+    --no_progress > "$out/train.log" 2>&1
+  status=$?
+  echo "train: exit $status after at most $train_s s" | tee -a "$out/suite.log"
+  if [ "$status" -ne 0 ] && [ "$status" -ne 124 ]; then failed+=(train); fi
+  for which in best latest; do
+    step "policy_$which" /dev/null python3 -c "import sys, torch
+state = torch.load(sys.argv[1], weights_only=True, map_location='cpu')
+keep = ('model', 'train', 'agent', 'update', 'env_steps', 'best_eval_return', 'last_eval')
+torch.save({k: state[k] for k in keep}, sys.argv[2])" "$run/checkpoints/$which.pt" "$run/policy_$which.pt"
+  done
+  rm -f "$run"/checkpoints/*.pt  # full checkpoints hold the envs' state (hundreds of MB at 8192 envs)
 fi
-echo "done: $(wc -l < "$out/bench_warp.jsonl") bench lines"
+if [ ${#failed[@]} -gt 0 ]; then
+  for name in "${failed[@]}"; do
+    echo "FAILED: $name" >&2
+    tail -5 "$out/$name.err" >&2 2>/dev/null
+  done
+  exit 1
+fi
+echo "gpu suite: every step passed ($(wc -l < "$out/bench_warp.jsonl") bench lines)"

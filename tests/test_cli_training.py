@@ -74,6 +74,22 @@ def test_eval_prints_and_writes_json(trained_run, tmp_path, capsys):
     assert {"return_mean", "return_std", "bounces_mean", "length_mean"} <= printed.keys()
 
 
+def test_eval_reads_a_policy_only_checkpoint_as_gpu_suite_writes_it(trained_run, tmp_path, capsys):
+    import torch
+
+    full = trained_run / "checkpoints" / "latest.pt"
+    state = torch.load(full, weights_only=True)
+    keep = ("model", "train", "agent", "update", "env_steps", "best_eval_return", "last_eval")
+    policy = tmp_path / "policy_latest.pt"
+    torch.save({k: state[k] for k in keep}, policy)  # as benchmarks/gpu_suite.sh keeps it: no env state
+    results = []
+    for checkpoint in (full, policy):
+        capsys.readouterr()
+        assert main(["eval", "--checkpoint", str(checkpoint), "--episodes", "2"]) == 0
+        results.append(json.loads(capsys.readouterr().out.strip().splitlines()[-1]))
+    assert results[0]["return_mean"] == results[1]["return_mean"]
+
+
 def test_play_writes_an_mp4_with_one_frame_per_step(trained_run, tmp_path):
     video = tmp_path / "play.mp4"
     ckpt = trained_run / "checkpoints" / "latest.pt"
