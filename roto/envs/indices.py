@@ -29,6 +29,7 @@ class SceneIndices:
     ball_vel: Columns  # (n_ball, 3) qvel indices of each ball's linear velocity
     tactile_force: Columns  # (n_links,) sensordata index of each link's normal force
     ball_force: Columns  # (n_ball,) sensordata index of each ball-hand normal force
+    self_contact: Columns  # (2,) sensordata indices of the hand's self-contact (found, distance m)
     default_qpos: torch.Tensor  # (1, nq), the balls' quaternions at identity
     coupled_driven: Columns
     coupled_driver: Columns
@@ -66,6 +67,7 @@ class SceneIndices:
             ball_vel=c(layout.ball_qvel[:, None] + np.arange(3)),
             tactile_force=c(layout.tactile_sensor + 1),
             ball_force=c(layout.ball_contact_sensor + 1),
+            self_contact=c([layout.self_contact_sensor, layout.self_contact_sensor + 1]),
             default_qpos=t(default, f64)[None],
             coupled_driven=c(driven),
             coupled_driver=c(driver),

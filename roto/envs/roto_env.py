@@ -23,7 +23,7 @@ from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
 from roto.envs.indices import SceneIndices
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
-from roto.envs.start_pool import StartPool
+from roto.envs.start_pool import StartPool, draw_valid_starts
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
 from roto.sim.backend import make_backend
@@ -357,8 +357,13 @@ class RotoEnv:
         return {name: start[f"frame/{name}"] for name in self.groups}
 
     def _draw_starts(self, n: int) -> dict[str, torch.Tensor]:
-        """n episode starts: hand at the default pose + noise, the task's balls placed, zero velocity;
-        their qpos (n, nq), joint targets (n, n_act) and first frame ("frame/<group>", (n, dim))."""
+        """n physically valid episode starts (``roto.envs.start_pool.draw_valid_starts``)."""
+        return draw_valid_starts(self._draw_candidates, n, self.robot.name)
+
+    def _draw_candidates(self, n: int) -> dict[str, torch.Tensor]:
+        """n candidate starts: hand at the default pose + noise, the task's balls placed, zero velocity;
+        their qpos (n, nq), joint targets (n, n_act), first frame ("frame/<group>", (n, dim)) and the
+        depth (m) of the hand's deepest self-contact ("penetration", (n,))."""
         idx = self._idx
         qpos = idx.default_qpos.expand(n, -1).clone()
         noise = uniform(self._generator, (n, self.num_actions), self.config.reset_joint_noise, self.device)
@@ -376,7 +381,10 @@ class RotoEnv:
         )
         last_action = torch.zeros(n, self.num_actions, dtype=torch.float32, device=self.device)
         frame = self._frame(qpos, qvel, sensors, inputs, target, last_action)
-        return {"qpos": qpos, "target": target, **{f"frame/{name}": value for name, value in frame.items()}}
+        found, dist = idx.self_contact.take(sensors).unbind(-1)
+        penetration = torch.where(found > 0, (-dist).clamp(min=0.0), 0.0)
+        frames = {f"frame/{name}": value for name, value in frame.items()}
+        return {"qpos": qpos, "target": target, **frames, "penetration": penetration}
 
     def _episode_info(self, truncated: torch.Tensor) -> dict[str, torch.Tensor]:
         info = {

@@ -5,7 +5,10 @@ The model holds, besides the hand, one free-floating sphere per ball and two kin
 
 * one per tactile link: ``body1 = link``, any partner, data ``found force`` reduced to the
   strongest contact, so the first force component is that contact's normal force;
-* one per ball: ``body1 = ball``, ``subtree2 = hand root`` (hand contact only, not ball-ball).
+* one per ball: ``body1 = ball``, ``subtree2 = hand root`` (hand contact only, not ball-ball);
+* one for the hand's self-contacts: ``subtree1 = subtree2 = hand root``, data ``found dist``
+  reduced to the deepest contact, which the env uses to keep interpenetrating poses out of
+  episode starts.
 """
 
 from __future__ import annotations
@@ -21,8 +24,8 @@ from roto.robots.spec import RobotSpec
 PHYSICS_DT = 1.0 / 240.0
 """Physics timestep (s), docs/spec.md §1."""
 
-_FOUND, _FORCE = 1, 2
-_REDUCE_MAXFORCE = 2
+_FOUND, _FORCE, _DIST = 1, 2, 8
+_REDUCE_MINDIST, _REDUCE_MAXFORCE = 1, 2
 CONTACT_SENSOR_DIM = 4
 """Values per contact sensor: (number of contacts found, force in the contact frame (3,))."""
 
@@ -55,6 +58,7 @@ class SceneLayout:
     ball_qpos: np.ndarray  # [n_ball] qpos address of each ball's free joint (position xyz, quat wxyz)
     ball_qvel: np.ndarray  # [n_ball] dof address of each ball's free joint (linear xyz, angular xyz)
     tactile_sensor: np.ndarray  # [n_tactile] sensordata address of each link's contact sensor
+    self_contact_sensor: int  # sensordata address of the hand's self-contact sensor (found, dist)
     ball_contact_sensor: np.ndarray  # [n_ball] sensordata address of each ball-hand contact sensor
     default_qpos: np.ndarray  # [nq] hand at its default pose, balls at the origin (placed by the task)
     hand_qpos: np.ndarray  # [n_hand_q] qpos addresses of every hand joint
@@ -70,6 +74,15 @@ def _add_contact_sensor(spec: mujoco.MjSpec, name: str, body: str, subtree2: str
         sensor.reftype = mujoco.mjtObj.mjOBJ_XBODY
         sensor.refname = subtree2
     sensor.intprm = np.array([_FOUND | _FORCE, _REDUCE_MAXFORCE, 1] + [0] * (len(sensor.intprm) - 3))
+
+
+def _add_self_contact_sensor(spec: mujoco.MjSpec, root: str) -> None:
+    sensor = spec.add_sensor()
+    sensor.name = "hand_self_contact"
+    sensor.type = mujoco.mjtSensor.mjSENS_CONTACT
+    sensor.objtype = sensor.reftype = mujoco.mjtObj.mjOBJ_XBODY
+    sensor.objname = sensor.refname = root
+    sensor.intprm = np.array([_FOUND | _DIST, _REDUCE_MINDIST, 1] + [0] * (len(sensor.intprm) - 3))
 
 
 def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...]) -> mujoco.MjSpec:
@@ -97,6 +110,7 @@ def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...]) -> mujoco.Mj
         _add_contact_sensor(spec, f"touch_{link}", link)
     for ball in balls:
         _add_contact_sensor(spec, f"hand_contact_{ball.name}", ball.name, subtree2=robot.root_body)
+    _add_self_contact_sensor(spec, robot.root_body)
     return spec
 
 
@@ -134,6 +148,7 @@ def scene_layout(model: mujoco.MjModel, robot: RobotSpec, balls: tuple[BallSpec,
         ball_qvel=model.jnt_dofadr[ball_joints].astype(np.int64),
         tactile_sensor=np.array([sensor_adr(f"touch_{link}") for link in robot.tactile_links], dtype=np.int64),
         ball_contact_sensor=np.array([sensor_adr(f"hand_contact_{b.name}") for b in balls], dtype=np.int64),
+        self_contact_sensor=sensor_adr("hand_self_contact"),
         default_qpos=default_qpos,
         hand_qpos=model.jnt_qposadr[hand_joints].astype(np.int64),
     )
