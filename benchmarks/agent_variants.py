@@ -130,10 +130,18 @@ def main() -> None:
     parser.add_argument("--runs", default="runs/variants")
     parser.add_argument("--out", default="benchmarks/results")
     parser.add_argument("--report_only", action="store_true", help="train nothing; report the finished runs")
+    parser.add_argument(
+        "--code_commit", default=None, help="commit the runs were trained at (default: HEAD when this script starts)"
+    )
     args = parser.parse_args()
     torch.set_num_threads(args.torch_threads)
     variants = args.variants or [v for v in VARIANTS[args.task] if v not in ("config", "base")]
     start = time.time()
+    # the code this process trains with: read now, since the checkout may move on while it runs
+    commit = (
+        args.code_commit
+        or subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    )
     results: dict[str, list[dict]] = {}
     for seed in args.seeds:  # seed-major: every variant gets its first seed before any gets a second
         for variant in variants:
@@ -147,7 +155,6 @@ def main() -> None:
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     stem = f"variants_{args.task}_{args.robot}_{args.obs}"
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     meta = {"commit": commit, "steps": args.steps, "seeds": args.seeds, "num_envs": args.num_envs,
             "threads": args.threads, "episodes": args.episodes, "base_config": VARIANTS[args.task]["config"],
             "base_overrides": VARIANTS[args.task]["base"],
