@@ -6,8 +6,13 @@ Every (variant, seed) is an ordinary run directory under ``--runs`` (``<runs>/<t
 The script is resumable: rerun the same command and finished runs are skipped, interrupted ones
 continue from their latest checkpoint, and missing final evaluations are done. Each run's final
 policy (``latest.pt``) and best policy (``best.pt``) are evaluated over ``--episodes`` fresh
-episodes, as ``roto eval`` does. The results go to ``<out>/variants_<task>_<robot>_<obs>.json``
-(every figure, with the commit) and a curve of the evaluation metric per variant (mean over seeds).
+episodes, as ``roto eval`` does. The results go to ``<out>/variants_<task>_<robot>_<obs>_<steps>k.json``
+(every figure, with the commits) and a curve of the evaluation metric per variant (mean over seeds).
+
+Each finished run leaves a small summary, ``<variant>_seed<k>.json`` in the folder of that name
+beside the table (its evaluation curve, final evaluations, costs and commit), meant to be committed; the table and
+plot are made from every summary in that folder, so seeds trained in different sittings (whose run
+directories are gone) still combine.
 """
 
 from __future__ import annotations
@@ -115,6 +120,22 @@ def summarize_run(run_dir: pathlib.Path, episodes: int) -> dict:
     }
 
 
+def report(task: str, folder: pathlib.Path, meta: dict) -> None:
+    """Tabulate and plot every run summary in ``folder`` (whichever sitting wrote it)."""
+    results: dict[str, list[dict]] = {}
+    for path in sorted(folder.glob("*_seed*.json")):
+        summary = json.loads(path.read_text())
+        results.setdefault(summary["variant"], []).append(summary)
+    stem = folder.name
+    commits = sorted({r["commit"] for runs in results.values() for r in runs})
+    overrides = {variant: VARIANTS[task][variant] for variant in results}
+    table = {"meta": {**meta, "overrides": overrides, "commits": commits}, "results": results}
+    (folder.parent / f"{stem}.json").write_text(json.dumps(table, indent=1))
+    curves = {variant: [r["evaluations"] for r in runs] for variant, runs in results.items()}
+    title = f"{stem}, commit {', '.join(commits)}"
+    plot_variants(curves, METRIC[task], folder.parent / f"{stem}.png", title=title)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("task", choices=sorted(VARIANTS))
@@ -129,7 +150,7 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=100)
     parser.add_argument("--runs", default="runs/variants")
     parser.add_argument("--out", default="benchmarks/results")
-    parser.add_argument("--report_only", action="store_true", help="train nothing; report the finished runs")
+    parser.add_argument("--report_only", action="store_true", help="train nothing; summarise finished runs, report")
     parser.add_argument(
         "--code_commit", default=None, help="commit the runs were trained at (default: HEAD when this script starts)"
     )
@@ -142,7 +163,8 @@ def main() -> None:
         args.code_commit
         or subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     )
-    results: dict[str, list[dict]] = {}
+    folder = pathlib.Path(args.out) / f"variants_{args.task}_{args.robot}_{args.obs}_{args.steps // 1000}k"
+    folder.mkdir(parents=True, exist_ok=True)
     for seed in args.seeds:  # seed-major: every variant gets its first seed before any gets a second
         for variant in variants:
             run_dir = pathlib.Path(args.runs) / args.task / variant / f"seed{seed}"
@@ -151,20 +173,12 @@ def main() -> None:
             elif not finished(run_dir, args.steps):
                 print(f"{run_dir}: not finished, left out of the report", flush=True)
                 continue
-            results.setdefault(variant, []).append(summarize_run(run_dir, args.episodes))
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    stem = f"variants_{args.task}_{args.robot}_{args.obs}"
-    meta = {"commit": commit, "steps": args.steps, "seeds": args.seeds, "num_envs": args.num_envs,
-            "threads": args.threads, "episodes": args.episodes, "base_config": VARIANTS[args.task]["config"],
-            "base_overrides": VARIANTS[args.task]["base"],
-            "overrides": {v: VARIANTS[args.task][v] for v in variants}}  # fmt: skip
-    (out / f"{stem}.json").write_text(json.dumps({"meta": meta, "results": results}, indent=1))
-    metric = METRIC[args.task]
-    runs = {v: [r["run_dir"] for r in rs] for v, rs in results.items()}
-    title = f"{args.task} / {args.robot} / {args.obs}, {args.num_envs} envs, commit {commit}"
-    plot_variants(runs, metric, out / f"{stem}.png", title=title)
-    print(f"done in {time.time() - start:.0f} s: {out / stem}.json", flush=True)
+            summary = {"variant": variant, "seed": seed, "commit": commit, **summarize_run(run_dir, args.episodes)}
+            (folder / f"{variant}_seed{seed}.json").write_text(json.dumps(summary, indent=1))
+    meta = {"steps": args.steps, "num_envs": args.num_envs, "threads": args.threads, "episodes": args.episodes,
+            "base_config": VARIANTS[args.task]["config"], "base_overrides": VARIANTS[args.task]["base"]}  # fmt: skip
+    report(args.task, folder, meta)
+    print(f"done in {time.time() - start:.0f} s: {folder}.json", flush=True)
 
 
 if __name__ == "__main__":

@@ -62,14 +62,14 @@ def plot_learning_curve(run_dir: str | pathlib.Path, out: str | pathlib.Path | N
 
 
 def plot_variants(
-    runs: Mapping[str, Sequence[str | pathlib.Path]], metric: str, out: str | pathlib.Path, title: str = ""
+    runs: Mapping[str, Sequence[Sequence[dict]]], metric: str, out: str | pathlib.Path, title: str = ""
 ) -> pathlib.Path:
     """Evaluation ``metric`` against env steps: per variant, the mean over its runs (seeds) with a
-    band from the lowest to the highest run. Runs are cut to the evaluations they all have."""
+    band from the lowest to the highest run. ``runs`` maps each variant to the evaluation records of
+    each of its runs (``read_evaluations``); runs are cut to the evaluations they all have."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2))
-    for variant, run_dirs in runs.items():
-        curves = [read_evaluations(d) for d in run_dirs]
+    for variant, curves in runs.items():
         length = min(len(c) for c in curves)
         if length == 0:
             continue
