@@ -2,7 +2,7 @@
 PYTHON ?= python3
 VENV := .venv
 STAMP := $(VENV)/.installed
-TEST_STAMP := $(VENV)/.installed-gpu-extra
+TEST_STAMP := $(VENV)/.installed-test-extras
 
 .PHONY: train test lint bench clean
 
@@ -13,9 +13,10 @@ $(STAMP): pyproject.toml
 	$(VENV)/bin/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
-# the tests also cover the Warp backend on Warp's CPU device, so they need the gpu extra
+# the tests also cover the Warp backend on Warp's CPU device and the learner adapters, so they
+# need the gpu and sb3 extras
 $(TEST_STAMP): $(STAMP)
-	$(VENV)/bin/python -m pip install --quiet -e '.[dev,gpu]'
+	$(VENV)/bin/python -m pip install --quiet -e '.[dev,gpu,sb3]'
 	touch $(TEST_STAMP)
 
 # The quick start: a blind Shadow Bounce agent on the CPU (about 15 minutes on 2 cores).
@@ -23,9 +24,10 @@ train: $(STAMP)
 	$(VENV)/bin/roto train --task bounce --robot shadow --obs blind --num_envs 128 --threads 2 \
 		--torch_threads 2 --steps 2500000 --agent_cfg roto/configs/bounce_cpu_quickstart.yaml
 
-# ROTO_REQUIRE_WARP: a missing MuJoCo Warp fails the Warp tests instead of skipping them
+# ROTO_REQUIRE_WARP / ROTO_REQUIRE_EXTRAS: a missing MuJoCo Warp or learner library fails its
+# tests instead of skipping them
 test: $(TEST_STAMP)
-	ROTO_REQUIRE_WARP=1 $(VENV)/bin/python -m pytest -q
+	ROTO_REQUIRE_WARP=1 ROTO_REQUIRE_EXTRAS=1 $(VENV)/bin/python -m pytest -q
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check . && $(VENV)/bin/ruff format --check .

@@ -17,6 +17,15 @@ def make_env(task: str = "bounce", **kwargs):
     return roto.make(task, **kwargs)
 
 
+def require_extra(module: str, extra: str) -> None:
+    """Skip without an optional extra's package, unless ROTO_REQUIRE_EXTRAS is set (``make test``),
+    then fail."""
+    if importlib.util.find_spec(module) is None:
+        if os.environ.get("ROTO_REQUIRE_EXTRAS"):
+            pytest.fail(f"{module} is not installed but ROTO_REQUIRE_EXTRAS is set: pip install -e '.[{extra}]'")
+        pytest.skip(f"{module} is not installed (pip install -e '.[{extra}]')", allow_module_level=True)
+
+
 def require_warp() -> None:
     """Skip without MuJoCo Warp, unless ROTO_REQUIRE_WARP is set (``make test``), then fail."""
     if importlib.util.find_spec("mujoco_warp") is None:
