@@ -13,10 +13,10 @@ $(STAMP): pyproject.toml
 	$(VENV)/bin/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
-# the tests also cover the Warp backend on Warp's CPU device and the learner adapters, so they
-# need the gpu and sb3 extras
+# the tests also cover the Warp backend on Warp's CPU device, the learner adapters and sweeps on
+# PostgreSQL, so they need the gpu, sb3 and postgres extras
 $(TEST_STAMP): $(STAMP)
-	$(VENV)/bin/python -m pip install --quiet -e '.[dev,gpu,sb3]'
+	$(VENV)/bin/python -m pip install --quiet -e '.[dev,gpu,sb3,postgres]'
 	touch $(TEST_STAMP)
 
 # The quick start: a blind Shadow Bounce agent on the CPU (about 15 minutes on 2 cores).

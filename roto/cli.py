@@ -1,4 +1,4 @@
-"""``roto`` command line: ``roto train``, ``eval``, ``play``, ``list``, ``bench``, ``demo``."""
+"""``roto`` command line: ``roto train``, ``eval``, ``play``, ``list``, ``bench``, ``demo``, ``sweep``."""
 
 from __future__ import annotations
 
@@ -6,6 +6,8 @@ import argparse
 import json
 import sys
 from collections.abc import Sequence
+
+from roto.sweep.command import add_sweep_parser
 
 
 def _add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
@@ -79,12 +81,14 @@ def _cmd_train(args: argparse.Namespace) -> int:
 
     from roto.envs.config import EnvConfig
     from roto.rl.config import load_agent_config
+    from roto.rl.overrides import apply_env_overrides, split_overrides
     from roto.rl.runner import Trainer, TrainSettings
 
     torch.set_num_threads(args.torch_threads)
     if args.resume:
         trainer = Trainer.resume(args.resume, total_steps=args.steps)
     else:
+        env_changes, agent_overrides = split_overrides(args.overrides)
         env = EnvConfig(  # validates task / robot / obs mode / backend before anything is written
             task=args.task,
             robot=args.robot,
@@ -95,8 +99,9 @@ def _cmd_train(args: argparse.Namespace) -> int:
             device=args.device,
             threads=args.threads,
         )
+        env = apply_env_overrides(env, env_changes)
         settings = TrainSettings(env=env, total_steps=args.steps if args.steps is not None else 1_000_000)
-        agent = load_agent_config(args.task, args.agent_cfg, args.overrides)
+        agent = load_agent_config(args.task, args.agent_cfg, agent_overrides)
         run_dir = args.run_dir or pathlib.Path("runs") / (
             f"{args.task}_{args.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{args.seed}"
         )
@@ -176,7 +181,12 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
         help="torch CPU threads for the PPO update; rollouts always use one (default 1)",
     )
     p_train.add_argument("--no_progress", "--no-progress", dest="no_progress", action="store_true")
-    p_train.add_argument("overrides", nargs="*", metavar="section.key=value", help="agent config overrides")
+    p_train.add_argument(
+        "overrides",
+        nargs="*",
+        metavar="section.key=value",
+        help="agent config overrides (ppo.lr=1e-4) and env overrides (env.num_envs=64)",
+    )
     p_train.set_defaults(func=_cmd_train)
 
 
@@ -243,6 +253,7 @@ def build_parser() -> argparse.ArgumentParser:
         _add_list_parser,
         _add_bench_parser,
         _add_demo_parser,
+        add_sweep_parser,
     ):
         add(sub)
     return parser

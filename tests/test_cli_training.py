@@ -5,6 +5,7 @@ import struct
 
 import imageio.v2 as imageio
 import pytest
+import yaml
 
 from roto.cli import main
 
@@ -41,12 +42,13 @@ def read_event_tags(events_dir):
 def trained_run(tmp_path_factory):
     run_dir = tmp_path_factory.mktemp("cli") / "run"
     args = ["train", "--num_envs", "4", "--steps", "48", "--run_dir", str(run_dir), "--no_progress", *TINY]
-    assert main(args) == 0
+    assert main([*args, "env.action_smoothing=0.9"]) == 0  # an env override beside the agent's
     return run_dir
 
 
 def test_train_writes_config_checkpoints_csv_and_events(trained_run, capsys):
-    assert (trained_run / "config.yaml").is_file()
+    config = yaml.safe_load((trained_run / "config.yaml").read_text())
+    assert config["train"]["env"]["action_smoothing"] == 0.9 and config["agent"]["ppo"]["rollouts"] == 4
     ckpts = trained_run / "checkpoints"
     assert (ckpts / "latest.pt").is_file() and (ckpts / "agent_3.pt").is_file()
     csv_text = (trained_run / "scalars.csv").read_text()
@@ -116,6 +118,8 @@ def test_play_writes_an_mp4_with_one_frame_per_step(trained_run, tmp_path):
         ),
         (["train", "--steps", "16", "--agent_cfg", "bounce_fd"], "packaged config: ['baoding'"),
         (["train", "--steps", "16", "network.actor=[privileged]"], "valid groups for this obs mode"),
+        (["train", "--steps", "16", "env.task=baoding"], "unknown env key 'task'; valid env keys: ['num_envs'"),
+        (["train", "--steps", "16", "env.num_envs=0"], "num_envs must be an integer >= 1, got 0"),
         (["eval", "--checkpoint", "config.yaml"], "'config.yaml' is not a roto checkpoint"),
     ],
 )

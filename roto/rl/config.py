@@ -177,20 +177,26 @@ def to_dict(config: Any) -> dict[str, Any]:
     return data
 
 
+def parse_override(item: str) -> tuple[str, Any]:
+    """``section.key=value`` -> (dotted key, value parsed as YAML)."""
+    key, sep, raw = item.partition("=")
+    if not sep or not key:
+        raise ValueError(f"override {item!r} must look like section.key=value (e.g. ppo.lr=1e-4)")
+    return key, yaml.safe_load(raw)
+
+
 def apply_overrides(data: dict[str, Any], overrides: list[str]) -> dict[str, Any]:
     """Apply ``section.key=value`` overrides to a nested dict (a new dict is returned)."""
     merged = yaml.safe_load(yaml.safe_dump(data)) or {}
     for item in overrides:
-        key, sep, raw = item.partition("=")
-        if not sep or not key:
-            raise ValueError(f"override {item!r} must look like section.key=value (e.g. ppo.lr=1e-4)")
+        key, value = parse_override(item)
         node = merged
         *parents, leaf = key.split(".")
         for part in parents:
             node = node.setdefault(part, {})
             if not isinstance(node, dict):
                 raise ValueError(f"override {item!r}: {part!r} is not a section")
-        node[leaf] = yaml.safe_load(raw)
+        node[leaf] = value
     return merged
 
 
@@ -234,5 +240,6 @@ __all__ = [
     "from_dict",
     "load_agent_config",
     "packaged_configs",
+    "parse_override",
     "to_dict",
 ]

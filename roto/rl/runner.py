@@ -116,8 +116,14 @@ class Trainer:
 
     # ------------------------------------------------------------------------ training
 
-    def train(self, progress: bool = True) -> dict[str, float]:
-        """Train until the step budget; returns the last evaluation's summary ({} if none ran)."""
+    def train(
+        self, progress: bool = True, on_update: Callable[[Trainer, dict[str, float]], None] | None = None
+    ) -> dict[str, float]:
+        """Train until the step budget; returns the last evaluation's summary ({} if none ran).
+
+        ``on_update(trainer, scalars)`` runs after each update is logged and checkpointed (a sweep
+        reports evaluations and stops diverged or pruned trials from it by raising).
+        """
         if self.obs is None:
             self.obs, _ = self.env.reset(seed=self.settings.env.seed)
         logger = ScalarLogger(self.run_dir, tensorboard=self.tensorboard)
@@ -145,6 +151,8 @@ class Trainer:
                 self._checkpoint()
                 bar.update(self.steps_per_update)
                 bar.set_postfix(self._postfix(scalars))
+                if on_update is not None:
+                    on_update(self, scalars)
         finally:
             bar.close()
             logger.close()

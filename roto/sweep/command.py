@@ -1,0 +1,97 @@
+"""``roto sweep``: run a study's workers; ``roto sweep export`` and ``roto sweep show``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+RUN_FLAGS = ("task", "robot", "obs", "agent_cfg", "space", "trials", "startup", "steps", "warmup_steps",
+             "num_envs", "threads", "root", "storage", "heartbeat")  # fmt: skip
+"""The ``SweepSettings`` fields the command line sets (besides the study name and overrides)."""
+
+
+def _study_args(parser: argparse.ArgumentParser, required: bool) -> None:
+    parser.add_argument("--study", required=required, help="study name (its folder: <root>/<study>)")
+    parser.add_argument("--root", default="runs/sweeps", help="folder of the studies' folders (default runs/sweeps)")
+    parser.add_argument("--storage", default=None, help="database URL (e.g. postgresql://...); default: journal file")
+
+
+def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
+    """Register ``roto sweep`` and its ``export`` and ``show`` subcommands."""
+    p = sub.add_parser("sweep", help="tune an agent with Optuna (TPE, median pruning), on one or many machines")
+    p.add_argument("--task", default="bounce")
+    p.add_argument("--robot", default="shadow")
+    p.add_argument("--obs", default="blind", help="blind, state or proprio")
+    p.add_argument("--agent_cfg", "--agent-cfg", dest="agent_cfg", default=None, help="base agent config")
+    p.add_argument("--space", default="roto2", help="search space: roto2 (default), roto1, or a YAML file")
+    p.add_argument("--trials", type=int, default=40, help="trials that finish (complete or pruned)")
+    p.add_argument("--startup", type=int, default=8, help="random start-up trials (also the pruner's wait)")
+    p.add_argument("--steps", type=int, default=2_500_000, help="env steps per trial")
+    p.add_argument("--warmup_steps", type=int, default=None, help="env steps before pruning (default steps/5)")
+    p.add_argument("--num_envs", type=int, default=128)
+    p.add_argument("--threads", type=int, default=1, help="C threads stepping each worker's envs")
+    p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
+    p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running trial's heartbeats")
+    p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="section.key=value",
+                   help="override every trial gets (env.num_envs=64, ppo.gamma=0.99); repeatable")  # fmt: skip
+    _study_args(p, required=False)
+    p.set_defaults(func=cmd_sweep)
+    actions = p.add_subparsers(dest="sweep_command", metavar="{export,show}")
+    export = actions.add_parser("export", help="write the best trial as an agent config for roto train --agent_cfg")
+    _study_args(export, required=True)
+    export.add_argument("--out", required=True, help="YAML file to write")
+    export.set_defaults(func=cmd_export)
+    show = actions.add_parser("show", help="print the trials table and the parameter importances")
+    _study_args(show, required=True)
+    show.set_defaults(func=cmd_show)
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    """Run ``--workers`` workers on the study until it has its trials."""
+    import torch
+
+    from roto.sweep.study import SweepSettings, open_study
+    from roto.sweep.worker import launch_workers, run_worker
+
+    if args.study is None:
+        raise ValueError("--study is required: the study's name (workers with the same name join one study)")
+    values = {name: getattr(args, name) for name in RUN_FLAGS}
+    settings = SweepSettings(study=args.study, overrides=tuple(args.overrides), **values)
+    if args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    if args.workers > 1:
+        open_study(settings)  # create it once, so the workers only join
+        return launch_workers(args.workers, _worker_argv(args))
+    torch.set_num_threads(args.torch_threads)
+    finished = run_worker(settings)
+    print(json.dumps({"study": settings.study, "finished_by_this_worker": finished}))
+    return 0
+
+
+def _worker_argv(args: argparse.Namespace) -> list[str]:
+    argv = ["--study", args.study, "--torch_threads", str(args.torch_threads)]
+    for name in RUN_FLAGS:
+        value = getattr(args, name)
+        if value is not None:
+            argv += [f"--{name}", str(value)]
+    for item in args.overrides:
+        argv += ["--set", item]
+    return argv
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    """Write the best trial's agent config."""
+    from roto.sweep.report import export_best
+
+    print(json.dumps(export_best(args.study, args.root, args.storage, args.out)))
+    return 0
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    """Print the study's trials and importances."""
+    from roto.sweep.report import show
+
+    sys.stdout.write(show(args.study, args.root, args.storage) + "\n")
+    return 0

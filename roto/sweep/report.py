@@ -1,0 +1,83 @@
+"""``roto sweep export`` (the best trial as an agent config) and ``roto sweep show`` (trials, importances)."""
+
+from __future__ import annotations
+
+import pathlib
+
+import optuna
+import yaml
+from optuna.trial import TrialState
+
+from roto.rl.config import load_agent_config, to_dict
+from roto.rl.overrides import split_overrides
+from roto.sweep.space import as_overrides
+from roto.sweep.storage import REASON_ATTR
+from roto.sweep.study import load_existing_study
+
+
+def export_best(name: str, root: str, storage_url: str | None, out: str | pathlib.Path) -> dict:
+    """Write the best complete trial's agent config to ``out`` (YAML ``roto train --agent_cfg`` loads).
+
+    Env parameters of the trial (``env.*``) are not agent settings: the file's header gives the
+    ``roto train`` command with them. Returns a summary of the trial.
+    """
+    study, settings = load_existing_study(name, root, storage_url)
+    if not study.get_trials(deepcopy=False, states=(TrialState.COMPLETE,)):
+        raise ValueError(f"study {name!r} has no complete trial yet; nothing to export")
+    best = study.best_trial
+    env_changes, agent_overrides = split_overrides([*settings["overrides"], *as_overrides(best.params)])
+    agent = load_agent_config(settings["task"], settings["agent_cfg"], agent_overrides)
+    env_args = " ".join(f"env.{k}={v}" for k, v in env_changes.items())
+    header = [
+        f"# roto sweep export: study {name!r}, trial {best.number}, best evaluation return {best.value:.3f}"
+        f" (seed {best.user_attrs.get('seed')}, {settings['steps']} env steps)",
+        f"# base config: {settings['agent_cfg'] or settings['task'] + ' (default)'}; search space: {settings['space']}",
+        f"# train with: roto train --task {settings['task']} --robot {settings['robot']} --obs {settings['obs']}"
+        f" --num_envs {settings['num_envs']} --agent_cfg {out} {env_args}".rstrip(),
+    ]
+    path = pathlib.Path(out)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(header) + "\n" + yaml.safe_dump(to_dict(agent), sort_keys=False))
+    return {"study": name, "trial": best.number, "value": best.value, "params": best.params, "out": str(path)}
+
+
+def trials_table(study: optuna.Study) -> str:
+    """A markdown table of every trial: number, state, objective, seed, parameters, why it ended."""
+    trials = study.get_trials(deepcopy=False)
+    keys = sorted({k for t in trials for k in t.params})
+    head = ["trial", "state", "best eval return", "seed", *keys, "reason"]
+    rows = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for t in trials:
+        value = f"{t.value:.3f}" if t.value is not None else ""
+        params = [_short(t.params[k]) if k in t.params else "" for k in keys]
+        cells = [str(t.number), t.state.name.lower(), value, str(t.user_attrs.get("seed", "")), *params]
+        rows.append("| " + " | ".join([*cells, t.user_attrs.get(REASON_ATTR, "")]) + " |")
+    return "\n".join(rows)
+
+
+def importances(study: optuna.Study) -> dict[str, float]:
+    """PED-ANOVA parameter importances over the finished trials ({} while too few have finished)."""
+    finished = study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.PRUNED))
+    if len(finished) < 2:
+        return {}
+    try:
+        evaluator = optuna.importance.PedAnovaImportanceEvaluator()
+        return optuna.importance.get_param_importances(study, evaluator=evaluator)
+    except (ValueError, RuntimeError):  # e.g. every finished trial has the same value
+        return {}
+
+
+def show(name: str, root: str, storage_url: str | None) -> str:
+    """The trials table and the parameter importances of a study, as markdown."""
+    study, _ = load_existing_study(name, root, storage_url)
+    lines = [f"study {name!r}: {len(study.trials)} trials", "", trials_table(study), ""]
+    found = importances(study)
+    if found:
+        lines += ["parameter importances (PED-ANOVA):", *(f"- {k}: {v:.3f}" for k, v in found.items())]
+    else:
+        lines.append("parameter importances: not enough finished trials yet")
+    return "\n".join(lines)
+
+
+def _short(value: object) -> str:
+    return f"{value:.3g}" if isinstance(value, float) else str(value)

@@ -1,0 +1,95 @@
+"""Where a study lives, and how a dead worker's trial is found and retried.
+
+Storage: Optuna's journal file in the study's folder by default (processes on one machine, or
+machines sharing a filesystem), or any database URL Optuna accepts (``postgresql://...``:
+workers on many machines join one study by running the same command).
+
+Liveness: a worker's running trial carries a heartbeat (a system attribute with the time, written
+every ``interval`` seconds by a thread). Before each new trial, a worker marks every running
+trial whose heartbeat is older than ``grace`` seconds as failed and enqueues a retry of it with the
+same parameters (Optuna's ``RetryHeartbeatStaleTrialCallback``); the retry resumes the dead trial's run
+directory from its latest checkpoint. This works the same on the journal and on a database
+(Optuna's own heartbeat exists only for databases). Machines' clocks must agree to well within
+``grace``.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import threading
+import time
+import warnings
+
+import optuna
+from optuna.exceptions import UpdateFinishedTrialError
+from optuna.storages import RetryHeartbeatStaleTrialCallback
+from optuna.storages.journal import JournalFileBackend, JournalStorage
+from optuna.trial import TrialState
+
+JOURNAL_NAME = "journal.log"
+HEARTBEAT_ATTR = "roto:heartbeat"
+REASON_ATTR = "reason"
+MAX_RETRY = 3
+"""Retries of one trial after its worker died (then it stays failed)."""
+
+with warnings.catch_warnings():  # Optuna marks the callback experimental; roto relies only on what it records
+    warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
+    enqueue_retry = RetryHeartbeatStaleTrialCallback(max_retry=MAX_RETRY)
+"""``enqueue_retry(study, failed_trial)``: a waiting copy of the trial, its system attribute
+``failed_trial`` naming the first try."""
+
+
+def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.storages.BaseStorage:
+    """The journal file in ``study_dir`` (created), or the database at ``url``."""
+    if url:
+        return optuna.storages.RDBStorage(url)
+    study_dir.mkdir(parents=True, exist_ok=True)
+    return JournalStorage(JournalFileBackend(str(study_dir / JOURNAL_NAME)))
+
+
+class Heartbeat:
+    """A thread writing the time into a running trial's system attributes every ``interval`` s."""
+
+    def __init__(self, storage: optuna.storages.BaseStorage, trial_id: int, interval: float) -> None:
+        self.storage, self.trial_id, self.interval = storage, trial_id, interval
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def __enter__(self) -> Heartbeat:
+        self.storage.set_trial_system_attr(self.trial_id, HEARTBEAT_ATTR, time.time())
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        self._thread.join()
+
+    def _run(self) -> None:
+        while not self._stop.wait(self.interval):
+            try:
+                self.storage.set_trial_system_attr(self.trial_id, HEARTBEAT_ATTR, time.time())
+            except UpdateFinishedTrialError:  # another worker declared this trial dead
+                return
+
+
+def fail_stale_trials(study: optuna.Study, storage: optuna.storages.BaseStorage, grace: float) -> list[int]:
+    """Mark running trials without a heartbeat for ``grace`` s as failed and enqueue their retries.
+
+    Returns the numbers of the trials this call failed (another worker may fail the same trial at
+    the same time; the storage lets exactly one of them do it).
+    """
+    failed = []
+    now = time.time()
+    for trial in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
+        beat = trial.system_attrs.get(HEARTBEAT_ATTR, trial.datetime_start.timestamp())
+        if now - beat <= grace:
+            continue
+        try:
+            storage.set_trial_user_attr(trial._trial_id, REASON_ATTR, f"no heartbeat for {now - beat:.0f} s")
+            if not storage.set_trial_state_values(trial._trial_id, TrialState.FAIL):
+                continue
+        except UpdateFinishedTrialError:
+            continue
+        enqueue_retry(study, storage.get_trial(trial._trial_id))
+        failed.append(trial.number)
+    return failed

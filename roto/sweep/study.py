@@ -1,0 +1,125 @@
+"""A sweep's settings and its Optuna study (TPE, median pruner), shared by every worker."""
+
+from __future__ import annotations
+
+import dataclasses
+import pathlib
+import random
+from dataclasses import dataclass
+from typing import Any
+
+import optuna
+
+from roto.envs.config import EnvConfig
+from roto.sweep.storage import JOURNAL_NAME, open_storage
+
+SEEDS = (0, 1, 2, 3, 4)
+"""Each trial trains with one of these seeds, drawn per trial (docs/spec.md §8)."""
+SETTINGS_ATTR = "roto:settings"
+
+
+@dataclass(frozen=True, kw_only=True)
+class SweepSettings:
+    """What a sweep searches and how; the fields of ``identity()`` must match for workers to join."""
+
+    study: str
+    task: str = "bounce"
+    robot: str = "shadow"
+    obs: str = "blind"
+    agent_cfg: str | None = None
+    """Base agent config (a YAML file or packaged name; None: the task's default)."""
+    overrides: tuple[str, ...] = ()
+    """``section.key=value`` overrides every trial gets (env and agent keys) under the searched ones."""
+    space: str = "roto2"
+    trials: int = 40
+    """Trials that finish (complete or pruned); failed ones are retried or replaced."""
+    startup: int = 8
+    """Random start-up trials of the TPE sampler; the pruner also waits for this many trials."""
+    steps: int = 2_500_000
+    """Env steps per trial."""
+    warmup_steps: int | None = None
+    """Env steps before a trial may be pruned (None: a fifth of ``steps``)."""
+    num_envs: int = 128
+    threads: int = 1
+    root: str = "runs/sweeps"
+    storage: str | None = None
+    """Database URL; None: the journal file in the study's folder."""
+    heartbeat: float = 30.0
+    """Seconds between a running trial's heartbeats; a trial silent for 4 of them is declared dead."""
+
+    def __post_init__(self) -> None:
+        """Reject values no sweep can use."""
+        if not self.study or "/" in self.study:
+            raise ValueError(f"the study name must be a non-empty name without '/', got {self.study!r}")
+        for name in ("trials", "steps", "num_envs", "threads"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.startup < 0 or self.heartbeat <= 0:
+            raise ValueError(f"startup must be >= 0 and heartbeat > 0, got {self.startup}, {self.heartbeat}")
+
+    @property
+    def study_dir(self) -> pathlib.Path:
+        """The study's folder: journal, and one run directory per trial."""
+        return pathlib.Path(self.root) / self.study
+
+    def base_env(self, seed: int = 0) -> EnvConfig:
+        """The trials' env config before overrides and searched env parameters."""
+        return EnvConfig(task=self.task, robot=self.robot, obs_mode=self.obs, num_envs=self.num_envs, seed=seed,
+                         threads=self.threads)  # fmt: skip
+
+    def identity(self) -> dict[str, Any]:
+        """The settings that define the study's trials (stored on the study, checked on joining)."""
+        keep = ("task", "robot", "obs", "agent_cfg", "overrides", "space", "trials", "steps", "num_envs")
+        data = {k: getattr(self, k) for k in keep}
+        data["overrides"] = list(self.overrides)
+        return data
+
+    def with_identity(self, identity: dict[str, Any]) -> SweepSettings:
+        """These settings with the study-defining ones taken from ``identity``."""
+        return dataclasses.replace(self, **{**identity, "overrides": tuple(identity["overrides"])})
+
+
+def trial_seed(study: str, number: int) -> int:
+    """The seed trial ``number`` of ``study`` trains with (drawn from ``SEEDS``, reproducibly)."""
+    return random.Random(f"{study}:{number}").choice(SEEDS)
+
+
+def open_study(settings: SweepSettings) -> tuple[optuna.Study, optuna.storages.BaseStorage]:
+    """Create the study, or join it when it exists (its stored settings must match these)."""
+    storage = open_storage(settings.study_dir, settings.storage)
+    # constant liar: parallel workers' running trials count as bad, so they do not all sample the same region
+    sampler = optuna.samplers.TPESampler(multivariate=True, n_startup_trials=settings.startup, constant_liar=True)
+    warmup = settings.warmup_steps if settings.warmup_steps is not None else settings.steps // 5
+    pruner = optuna.pruners.MedianPruner(n_startup_trials=settings.startup, n_warmup_steps=warmup)
+    study = optuna.create_study(
+        study_name=settings.study,
+        storage=storage,
+        sampler=sampler,
+        pruner=pruner,
+        direction="maximize",
+        load_if_exists=True,
+    )
+    stored = study.user_attrs.get(SETTINGS_ATTR)
+    if stored is None:
+        study.set_user_attr(SETTINGS_ATTR, settings.identity())
+    elif stored != settings.identity():
+        differ = {k: (stored.get(k), v) for k, v in settings.identity().items() if stored.get(k) != v}
+        raise ValueError(
+            f"study {settings.study!r} exists with other settings (stored, given): {differ}; "
+            "use another --study name or the study's settings"
+        )
+    return study, storage
+
+
+def load_existing_study(name: str, root: str, storage_url: str | None) -> tuple[optuna.Study, dict[str, Any]]:
+    """An existing study and its stored settings (for ``export`` and ``show``)."""
+    folder = pathlib.Path(root) / name
+    if storage_url is None and not (folder / JOURNAL_NAME).is_file():
+        found = sorted(p.parent.name for p in pathlib.Path(root).glob(f"*/{JOURNAL_NAME}"))
+        raise ValueError(f"no study {name!r} under {root!r} (no {folder / JOURNAL_NAME}); studies there: {found}")
+    storage = open_storage(folder, storage_url)
+    names = [s.study_name for s in optuna.get_all_study_summaries(storage, include_best_trial=False)]
+    if name not in names:
+        raise ValueError(f"no study {name!r} in this storage; studies there: {names}")
+    study = optuna.load_study(study_name=name, storage=storage)
+    return study, study.user_attrs.get(SETTINGS_ATTR, {})

@@ -1,0 +1,110 @@
+"""One sweep trial: an ordinary training run whose evaluations feed the pruner.
+
+The trial's run directory is ``<study folder>/trial_<number>`` (a retried trial continues the run
+directory of the trial it retries, from its latest checkpoint), so ``roto eval``, ``roto play`` and
+``roto train --resume`` work on any trial. The objective is the best evaluation mean return of the
+run; after each evaluation the best so far is reported at the run's env steps, and the median
+pruner may stop the trial there. A trial whose loss or weights stop being finite ends pruned, the
+reason stored on the trial.
+"""
+
+from __future__ import annotations
+
+import math
+import pathlib
+from collections.abc import Callable
+from typing import Any
+
+import optuna
+import torch
+
+from roto.envs.config import EnvConfig
+from roto.envs.roto_env import RotoEnv
+from roto.rl.config import load_agent_config
+from roto.rl.evaluation import read_evaluations
+from roto.rl.overrides import apply_env_overrides, split_overrides
+from roto.rl.runner import CHECKPOINT_DIR, Trainer
+from roto.rl.settings import TrainSettings
+from roto.sweep.space import SearchSpace, as_overrides
+from roto.sweep.study import SweepSettings, trial_seed
+
+
+class Diverged(RuntimeError):
+    """A trial's loss or weights are no longer finite."""
+
+
+def run_dir_of(settings: SweepSettings, number: int) -> pathlib.Path:
+    """The run directory of trial ``number``."""
+    return settings.study_dir / f"trial_{number:04d}"
+
+
+class TrialMonitor:
+    """``Trainer.train``'s per-update hook: divergence checks, evaluation reports, pruning."""
+
+    def __init__(self, trial: optuna.Trial, best: float = -math.inf) -> None:
+        self.trial, self.best = trial, best
+
+    def __call__(self, trainer: Trainer, scalars: dict[str, float]) -> None:
+        """Raise ``Diverged`` or ``optuna.TrialPruned`` to end the trial."""
+        bad = {k: v for k, v in scalars.items() if k.startswith("loss/") and not math.isfinite(v)}
+        if bad:
+            raise Diverged(f"non-finite loss at update {trainer.update}: {bad}")
+        if "eval/return_mean" not in scalars:
+            return
+        if not all(bool(torch.isfinite(p).all()) for p in trainer.model.parameters()):
+            raise Diverged(f"non-finite weights at update {trainer.update}")
+        self.best = max(self.best, scalars["eval/return_mean"])
+        self.trial.report(self.best, trainer.env_steps)
+        if self.trial.should_prune():
+            raise optuna.TrialPruned(
+                f"pruned at {trainer.env_steps} env steps: best evaluation return {self.best:.3f} is below the median"
+            )
+
+
+def build_trainer(
+    settings: SweepSettings, params: dict[str, Any], run_dir: pathlib.Path, seed: int, env_factory: Callable
+) -> Trainer:
+    """A trainer for a new trial: the study's env and base config with the drawn parameters."""
+    env_changes, agent_overrides = split_overrides([*settings.overrides, *as_overrides(params)])
+    env = apply_env_overrides(settings.base_env(seed), env_changes)
+    agent = load_agent_config(settings.task, settings.agent_cfg, agent_overrides)
+    return Trainer(TrainSettings(env=env, total_steps=settings.steps), agent, run_dir, env_factory=env_factory)
+
+
+def run_trial(
+    trial: optuna.Trial,
+    settings: SweepSettings,
+    space: SearchSpace,
+    system_attrs: dict[str, Any],
+    env_factory: Callable[[EnvConfig], Any] = RotoEnv,
+) -> float:
+    """Train the trial's run (or continue the run of the trial it retries); its best evaluation return.
+
+    ``system_attrs``: the trial's system attributes (a retry names the trial it retries there).
+    """
+    params = space.suggest(trial)
+    retried = system_attrs.get("failed_trial")  # the retry callback's record of the first try
+    number = trial.number if retried is None else int(retried)
+    run_dir = run_dir_of(settings, number)
+    seed = trial_seed(settings.study, number)
+    trial.set_user_attr("seed", seed)
+    trial.set_user_attr("run_dir", str(run_dir))
+    monitor = TrialMonitor(trial)
+    if (run_dir / CHECKPOINT_DIR / "latest.pt").is_file():
+        trainer = Trainer.resume(run_dir, env_factory=env_factory)
+        for record in read_evaluations(run_dir):  # the earlier try's reports, on this trial
+            monitor.best = max(monitor.best, record["return_mean"])
+            trial.report(monitor.best, record["env_steps"])
+    else:
+        trainer = build_trainer(settings, params, run_dir, seed, env_factory)
+    try:
+        trainer.train(progress=False, on_update=monitor)
+    except (ValueError, RuntimeError) as error:
+        # non-finite weights make non-finite actions, which the env refuses before the hook sees them
+        if isinstance(error, Diverged) or all(bool(torch.isfinite(p).all()) for p in trainer.model.parameters()):
+            raise
+        raise Diverged(f"non-finite weights at update {trainer.update}: {error}") from error
+    finally:
+        trainer.env.close()
+        trainer.evaluator.env.close()
+    return max(record["return_mean"] for record in read_evaluations(run_dir))

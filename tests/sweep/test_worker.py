@@ -1,0 +1,153 @@
+import json
+import multiprocessing
+import os
+import signal
+import time
+
+import optuna
+import pytest
+import torch
+import yaml
+from optuna.trial import TrialState
+
+from roto.rl.config import load_agent_config
+from roto.rl.evaluation import read_evaluations
+from roto.rl.runner import CHECKPOINT_DIR
+from roto.sweep.report import export_best, show
+from roto.sweep.storage import REASON_ATTR, open_storage
+from roto.sweep.study import SEEDS, open_study
+from roto.sweep.trial import run_dir_of
+from roto.sweep.worker import run_worker
+from tests.rl.toy_env import ToyEnv
+from tests.sweep.toy_sweep import toy_settings, toy_worker
+
+FINISHED = (TrialState.COMPLETE, TrialState.PRUNED)
+
+
+def finished_trials(settings):
+    study = optuna.load_study(study_name=settings.study, storage=open_storage(settings.study_dir, settings.storage))
+    return study, study.get_trials(states=FINISHED)
+
+
+def test_a_four_trial_toy_sweep_completes_and_exports_a_loadable_config(tmp_path):
+    torch.set_num_threads(1)
+    settings = toy_settings(tmp_path, trials=4)
+    assert run_worker(settings, env_factory=ToyEnv) == 4
+    study, finished = finished_trials(settings)
+    assert len(study.trials) == 4 and len(finished) == 4
+    for trial in finished:
+        run_dir = run_dir_of(settings, trial.number)
+        records = read_evaluations(run_dir)  # an ordinary run directory: config, evaluations, checkpoints
+        assert (run_dir / "config.yaml").is_file() and (run_dir / CHECKPOINT_DIR / "best.pt").is_file()
+        assert trial.user_attrs["seed"] in SEEDS
+        if trial.state == TrialState.COMPLETE:
+            assert records[-1]["env_steps"] == settings.steps
+            assert trial.value == max(r["return_mean"] for r in records)
+        # the drawn parameters are the ones the run trained with
+        config = yaml.safe_load((run_dir / "config.yaml").read_text())
+        assert config["agent"]["ppo"]["lr"] == trial.params["ppo.lr"]
+        assert config["agent"]["ppo"]["epochs"] == trial.params["ppo.epochs"]
+        assert config["train"]["env"]["action_smoothing"] == trial.params["env.action_smoothing"]
+        assert config["train"]["env"]["seed"] == trial.user_attrs["seed"]
+
+    out = tmp_path / "best.yaml"
+    summary = export_best(settings.study, settings.root, None, out)
+    agent = load_agent_config("bounce", out)
+    best = study.best_trial
+    assert summary["trial"] == best.number
+    assert agent.ppo.lr == best.params["ppo.lr"] and agent.ppo.epochs == best.params["ppo.epochs"]
+    assert agent.network.encoder == (16,) and agent.ppo.rollouts == 4  # the study's fixed overrides too
+    assert f"env.action_smoothing={best.params['env.action_smoothing']}" in out.read_text()
+
+    table = show(settings.study, settings.root, None)
+    assert table.count("| complete |") + table.count("| pruned |") == 4
+
+    # rerunning the command continues the study up to its count: nothing left to do
+    assert run_worker(settings, env_factory=ToyEnv) == 0
+    assert len(finished_trials(settings)[0].trials) == 4
+
+
+def test_two_worker_processes_on_one_journal_finish_exactly_the_trial_count(tmp_path):
+    settings = toy_settings(tmp_path, trials=6)
+    open_study(settings)
+    context = multiprocessing.get_context("spawn")
+    workers = [context.Process(target=toy_worker, args=(settings,)) for _ in range(2)]
+    for worker in workers:
+        worker.start()
+    for worker in workers:
+        worker.join(timeout=300)
+        assert worker.exitcode == 0
+    study, finished = finished_trials(settings)
+    numbers = [t.number for t in finished]
+    assert len(finished) == 6 and len(set(numbers)) == 6
+    # none lost: every finished trial has its value and its run's evaluations
+    for trial in finished:
+        assert trial.value is not None and read_evaluations(run_dir_of(settings, trial.number))
+    # whatever else is in the study is a surplus claim told failed at once
+    others = [t for t in study.trials if t.state not in FINISHED]
+    assert all(t.state == TrialState.FAIL and t.user_attrs[REASON_ATTR].startswith("surplus") for t in others)
+
+
+def test_a_killed_workers_trial_is_failed_and_retried_from_its_checkpoint(tmp_path):
+    settings = toy_settings(tmp_path, trials=2, updates=60, heartbeat=0.5)
+    open_study(settings)
+    worker = multiprocessing.get_context("spawn").Process(target=toy_worker, args=(settings,))
+    worker.start()
+    first_run = run_dir_of(settings, 0)
+    deadline = time.time() + 120
+    while len(read_evaluations(first_run)) < 2:  # killed mid-trial, after a few checkpoints
+        assert time.time() < deadline and worker.is_alive()
+        time.sleep(0.2)
+    os.kill(worker.pid, signal.SIGKILL)
+    worker.join()
+    killed_at = len(read_evaluations(first_run))
+    time.sleep(4 * settings.heartbeat + 0.5)  # the grace period passes without a heartbeat
+
+    assert run_worker(settings, env_factory=ToyEnv) == 2
+    study = optuna.load_study(study_name=settings.study, storage=open_storage(settings.study_dir))
+    first = study.trials[0]
+    assert first.state == TrialState.FAIL and "no heartbeat" in first.user_attrs[REASON_ATTR]
+    retries = [t for t in study.trials if t.system_attrs.get("failed_trial") == 0]
+    assert len(retries) == 1 and retries[0].state in FINISHED
+    assert retries[0].params == first.params and retries[0].user_attrs["run_dir"] == str(first_run)
+    records = read_evaluations(first_run)
+    steps = [r["env_steps"] for r in records]
+    assert steps == sorted(set(steps)) and len(records) > killed_at  # resumed, not restarted
+    assert len(study.get_trials(states=FINISHED)) == 2
+
+
+class NanRewardToyEnv(ToyEnv):
+    """The toy env whose rewards turn NaN after 16 steps: every trial diverges."""
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = super().step(action)
+        self.steps = getattr(self, "steps", 0) + 1
+        return obs, reward * (float("nan") if self.steps > 16 else 1.0), terminated, truncated, info
+
+
+def test_diverging_trials_end_pruned_with_the_reason_and_the_study_goes_on(tmp_path):
+    settings = toy_settings(tmp_path, trials=3)
+    assert run_worker(settings, env_factory=NanRewardToyEnv) == 3
+    study, finished = finished_trials(settings)
+    assert [t.state for t in study.trials] == [TrialState.PRUNED] * 3
+    assert all("non-finite" in t.user_attrs[REASON_ATTR] for t in finished)
+
+
+def test_joining_a_study_with_other_settings_is_an_error(tmp_path):
+    open_study(toy_settings(tmp_path, trials=4))
+    with pytest.raises(ValueError, match=r"exists with other settings.*trials"):
+        open_study(toy_settings(tmp_path, trials=5))
+
+
+def test_cli_sweep_needs_a_study_and_show_names_missing_ones(tmp_path, capsys):
+    from roto.cli import main
+
+    assert main(["sweep", "--trials", "2"]) == 2
+    assert "--study is required" in capsys.readouterr().err
+    assert main(["sweep", "show", "--study", "nope", "--root", str(tmp_path)]) == 2
+    assert "no study 'nope'" in capsys.readouterr().err
+    settings = toy_settings(tmp_path, trials=1)
+    run_worker(settings, env_factory=ToyEnv)
+    capsys.readouterr()
+    assert main(["sweep", "export", "--study", "toy", "--root", str(tmp_path), "--out", str(tmp_path / "b.yaml")]) == 0
+    assert json.loads(capsys.readouterr().out)["trial"] == 0
