@@ -67,8 +67,10 @@ def test_a_four_trial_toy_sweep_completes_and_exports_a_loadable_config(tmp_path
     assert len(finished_trials(settings)[0].trials) == 4
 
 
-def test_two_worker_processes_on_one_journal_finish_exactly_the_trial_count(tmp_path):
-    settings = toy_settings(tmp_path, trials=6)
+@pytest.mark.parametrize("storage", ["journal", "postgresql"])
+def test_two_worker_processes_on_one_study_finish_exactly_the_trial_count(tmp_path, storage, request):
+    url = request.getfixturevalue("postgres_url") if storage == "postgresql" else None
+    settings = toy_settings(tmp_path, trials=6, study=f"toy_two_workers_{storage}", storage=url)
     open_study(settings)
     context = multiprocessing.get_context("spawn")
     workers = [context.Process(target=toy_worker, args=(settings,)) for _ in range(2)]
