@@ -19,7 +19,7 @@ from roto.sweep.study import SEEDS, open_study
 from roto.sweep.trial import run_dir_of
 from roto.sweep.worker import run_worker
 from tests.rl.toy_env import ToyEnv
-from tests.sweep.toy_sweep import toy_settings, toy_worker
+from tests.sweep.toy_sweep import TOY_OVERRIDES, toy_settings, toy_worker
 
 FINISHED = (TrialState.COMPLETE, TrialState.PRUNED)
 
@@ -153,3 +153,19 @@ def test_cli_sweep_needs_a_study_and_show_names_missing_ones(tmp_path, capsys):
     capsys.readouterr()
     assert main(["sweep", "export", "--study", "toy", "--root", str(tmp_path), "--out", str(tmp_path / "b.yaml")]) == 0
     assert json.loads(capsys.readouterr().out)["trial"] == 0
+
+
+def test_cli_workers_run_a_study_on_the_real_env_and_show_it(tmp_path, capsys):
+    from roto.cli import main
+
+    space = toy_settings(tmp_path, trials=2).space  # writes the toy space file
+    fixed = [arg for override in TOY_OVERRIDES for arg in ("--set", override)]
+    args = ["sweep", "--study", "cli", "--root", str(tmp_path), "--space", space, "--trials", "2", "--startup", "1",
+            "--steps", "16", "--num_envs", "2", "--workers", "2", *fixed]  # fmt: skip
+    assert main(args) == 0
+    study = optuna.load_study(study_name="cli", storage=open_storage(tmp_path / "cli"))
+    assert len(study.get_trials(states=FINISHED)) == 2
+    capsys.readouterr()
+    assert main(["sweep", "show", "--study", "cli", "--root", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "| trial | state | best eval return | seed | env.action_smoothing | ppo.epochs | ppo.lr | reason |" in out
