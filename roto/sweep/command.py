@@ -52,8 +52,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     """Run ``--workers`` workers on the study until it has its trials."""
     import torch
 
+    from roto.sweep.claims import launch_workers
     from roto.sweep.study import SweepSettings, open_study
-    from roto.sweep.worker import launch_workers, run_worker
+    from roto.sweep.worker import run_worker
 
     if args.study is None:
         raise ValueError("--study is required: the study's name (workers with the same name join one study)")
@@ -63,7 +64,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.workers > 1:
         open_study(settings)  # create it once, so the workers only join
-        return launch_workers(args.workers, _worker_argv(args))
+        return launch_workers("sweep", args.workers, _worker_argv(args))
     torch.set_num_threads(args.torch_threads)
     finished = run_worker(settings)
     print(json.dumps({"study": settings.study, "finished_by_this_worker": finished}))

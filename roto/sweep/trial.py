@@ -29,8 +29,8 @@ from roto.sweep.space import SearchSpace, as_overrides
 from roto.sweep.study import SweepSettings, trial_seed
 
 
-class Diverged(RuntimeError):
-    """A trial's loss or weights are no longer finite."""
+class Diverged(optuna.TrialPruned):
+    """A trial's loss or weights are no longer finite (it ends pruned, this the reason)."""
 
 
 def run_dir_of(settings: SweepSettings, number: int) -> pathlib.Path:
@@ -101,7 +101,7 @@ def run_trial(
         trainer.train(progress=False, on_update=monitor)
     except (ValueError, RuntimeError) as error:
         # non-finite weights make non-finite actions, which the env refuses before the hook sees them
-        if isinstance(error, Diverged) or all(bool(torch.isfinite(p).all()) for p in trainer.model.parameters()):
+        if all(bool(torch.isfinite(p).all()) for p in trainer.model.parameters()):
             raise
         raise Diverged(f"non-finite weights at update {trainer.update}: {error}") from error
     finally:

@@ -1,0 +1,82 @@
+"""Running a claimed trial: heartbeat while it works, then tell the storage how it ended.
+
+Shared by ``roto sweep`` (a trial is a set of parameters) and ``roto olympiad`` (a trial is a
+cell of the plan). A ``optuna.TrialPruned`` from the work ends the trial pruned with its message
+as the reason; any other exception, Ctrl-C included, fails it and enqueues a retry, then goes on
+up. ``launch_workers`` starts worker processes of a ``roto`` subcommand here.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Sequence
+
+import optuna
+from optuna.exceptions import UpdateFinishedTrialError
+from optuna.trial import TrialState
+
+from roto.sweep.storage import REASON_ATTR, Heartbeat, enqueue_retry
+
+
+def run_claimed(
+    study: optuna.Study,
+    storage: optuna.storages.BaseStorage,
+    trial: optuna.Trial,
+    interval: float,
+    work: Callable[[dict], float],
+) -> bool:
+    """``work(system_attrs)`` with a heartbeat every ``interval`` s, then tell its outcome.
+
+    Returns True when the outcome was told, False when another worker had declared the trial dead
+    meanwhile (its retry then counts instead).
+    """
+    trial_id = trial._trial_id  # the storage's id: heartbeats and system attributes are written by id
+    start = time.perf_counter()
+    state, value, reason = TrialState.COMPLETE, None, None
+    try:
+        with Heartbeat(storage, trial_id, interval):
+            value = work(storage.get_trial(trial_id).system_attrs)
+    except optuna.TrialPruned as error:
+        state, reason = TrialState.PRUNED, str(error)
+    except BaseException as error:  # Ctrl-C or a crash: fail it and enqueue a retry that resumes its run
+        fail_and_retry(study, storage, trial, f"{type(error).__name__}: {error}")
+        raise
+    try:
+        if reason:
+            trial.set_user_attr(REASON_ATTR, reason)
+        study.tell(trial, value, state=state)
+    except UpdateFinishedTrialError:
+        return False
+    shown = f"{value:.3f}" if value is not None else reason
+    print(f"trial {trial.number}: {state.name.lower()}, {shown} ({time.perf_counter() - start:.0f} s)", flush=True)
+    return True
+
+
+def tell_failed(study: optuna.Study, trial: optuna.Trial, reason: str) -> None:
+    """End a claimed trial that will not run (surplus, duplicate) as failed, with the reason."""
+    trial.set_user_attr(REASON_ATTR, reason)
+    study.tell(trial, state=TrialState.FAIL)
+
+
+def fail_and_retry(study: optuna.Study, storage: optuna.storages.BaseStorage, trial: optuna.Trial, reason: str) -> None:
+    """Tell ``trial`` failed with ``reason`` and enqueue a retry (unless another worker failed it first)."""
+    try:
+        tell_failed(study, trial, reason)
+    except UpdateFinishedTrialError:
+        return
+    enqueue_retry(study, storage.get_trial(trial._trial_id))
+
+
+def launch_workers(command: str, count: int, argv: Sequence[str]) -> int:
+    """Run ``count`` ``roto <command> <argv> --workers 1`` processes here; the worst exit code.
+
+    Ctrl-C reaches every worker (one process group); each fails and re-enqueues its running trial.
+    """
+    line = [sys.executable, "-m", "roto.cli", command, *argv, "--workers", "1"]
+    processes = [subprocess.Popen(line) for _ in range(count)]
+    try:
+        return max(p.wait() for p in processes)
+    except KeyboardInterrupt:
+        return max(p.wait() for p in processes)
