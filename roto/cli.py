@@ -1,4 +1,5 @@
-"""``roto`` command line: ``roto train``, ``eval``, ``play``, ``list``, ``bench``, ``demo``, ``sweep``."""
+"""``roto`` command line: ``roto train``, ``eval``, ``play``, ``render``, ``list``, ``bench``, ``demo``, ``sweep``,
+``olympiad``, ``results``."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import json
 import sys
 from collections.abc import Sequence
 
+from roto.olympiad.command import add_olympiad_parsers
 from roto.sweep.command import add_sweep_parser
 
 
@@ -254,6 +256,7 @@ def build_parser() -> argparse.ArgumentParser:
         _add_bench_parser,
         _add_demo_parser,
         add_sweep_parser,
+        add_olympiad_parsers,
     ):
         add(sub)
     return parser

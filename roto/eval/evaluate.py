@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 import torch
 
+from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
 from roto.eval.episodes import first_episodes
 from roto.rl.networks import ActorCritic
@@ -17,9 +20,13 @@ MAX_PARALLEL_ENVS = 128
 
 @torch.no_grad()
 def evaluate(
-    model: ActorCritic, settings: TrainSettings, episodes: int = 100, seed: int = 1_000_000
+    model: ActorCritic,
+    settings: TrainSettings,
+    episodes: int = 100,
+    seed: int = 1_000_000,
+    env_factory: Callable[[EnvConfig], Any] = RotoEnv,
 ) -> dict[str, object]:
-    """Run ``episodes`` full episodes, one per env (so short episodes are not favoured).
+    """Run ``episodes`` full episodes, one per env (so short episodes are not favoured), on the CPU.
 
     Returns mean and std of the return, length and every task metric, and the per-episode lists.
     """
@@ -28,7 +35,7 @@ def evaluate(
     per_episode: dict[str, list[float]] = {}
     for batch in range(math.ceil(episodes / MAX_PARALLEL_ENVS)):
         n = min(MAX_PARALLEL_ENVS, episodes - batch * MAX_PARALLEL_ENVS)
-        env = RotoEnv(settings.cpu_env_config(num_envs=n, seed=seed + batch))
+        env = env_factory(settings.cpu_env_config(num_envs=n, seed=seed + batch))
         obs, _ = env.reset(seed=seed + batch)
         with single_torch_thread(env.device):
             result = first_episodes(env, model.act_deterministic, obs)

@@ -62,26 +62,33 @@ def plot_learning_curve(run_dir: str | pathlib.Path, out: str | pathlib.Path | N
 
 
 def plot_variants(
-    runs: Mapping[str, Sequence[Sequence[dict]]], metric: str, out: str | pathlib.Path, title: str = ""
+    runs: Mapping[str, Sequence[Sequence[dict]]],
+    metric: str,
+    out: str | pathlib.Path,
+    title: str = "",
+    xs: Sequence[str] = ("env_steps",),
 ) -> pathlib.Path:
-    """Evaluation ``metric`` against env steps: per variant, the mean over its runs (seeds) with a
-    band from the lowest to the highest run. ``runs`` maps each variant to the evaluation records of
-    each of its runs (``read_evaluations``); runs are cut to the evaluations they all have."""
+    """Evaluation ``metric`` against each of ``xs`` (record keys: ``env_steps``, ``train_wall_s``),
+    one panel each: per variant, the mean over its runs (seeds) with a band from the lowest to the
+    highest run. ``runs`` maps each variant to the evaluation records of each of its runs
+    (``read_evaluations``); runs are cut to the evaluations they all have, and an x value is the
+    mean over the runs at that evaluation."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 4.2))
-    for variant, curves in runs.items():
-        length = min(len(c) for c in curves)
-        if length == 0:
-            continue
-        steps = np.array([r["env_steps"] for r in curves[0][:length]])
-        values = np.array([[r[f"{metric}_mean"] for r in c[:length]] for c in curves])
-        (line,) = ax.plot(steps, values.mean(axis=0), label=f"{variant} ({len(curves)} seeds)")
-        ax.fill_between(steps, values.min(axis=0), values.max(axis=0), color=line.get_color(), alpha=0.15)
-    ax.set_xlabel("env steps")
-    ax.set_ylabel(f"evaluation {metric} (mean over seeds)")
-    ax.grid(alpha=0.3)
-    ax.legend(loc="upper left")
-    ax.set_title(title)
+    fig, axes = plt.subplots(1, len(xs), figsize=(7 * len(xs), 4.2), squeeze=False)
+    for ax, x in zip(axes[0], xs, strict=True):
+        for variant, curves in runs.items():
+            length = min(len(c) for c in curves)
+            if length == 0:
+                continue
+            position = np.array([[r[x] for r in c[:length]] for c in curves]).mean(axis=0)
+            values = np.array([[r[f"{metric}_mean"] for r in c[:length]] for c in curves])
+            (line,) = ax.plot(position, values.mean(axis=0), label=f"{variant} ({len(curves)} seeds)")
+            ax.fill_between(position, values.min(axis=0), values.max(axis=0), color=line.get_color(), alpha=0.15)
+        ax.set_xlabel({"env_steps": "env steps", "train_wall_s": "training wall time (s)"}.get(x, x))
+        ax.set_ylabel(f"evaluation {metric} (mean over seeds)")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper left")
+        ax.set_title(title)
     fig.tight_layout()
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -1,0 +1,86 @@
+"""One Olympiad cell: train its run, evaluate its final and best policies, write its summary.
+
+The run directory is ``<root>/<plan>/<cell>`` (an ordinary run: ``roto eval``, ``roto play`` and
+``roto train --resume`` work on it); a cell whose run has a checkpoint continues from it. The
+summary, ``<results>/<cell>.json``, is small enough to commit: the evaluation curve, the final and
+best policies' evaluations over the plan's episodes (per-episode returns and task metrics
+included), the training wall time and the commit. ``roto results`` reads only summaries, so
+cells trained on other machines or in other sittings combine.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import pathlib
+import subprocess
+from collections.abc import Callable
+from typing import Any
+
+from roto.envs.config import EnvConfig
+from roto.envs.roto_env import RotoEnv
+from roto.eval.evaluate import evaluate
+from roto.olympiad.plan import Cell, Plan
+from roto.rl.checkpoints import load_checkpoint
+from roto.rl.config import load_agent_config
+from roto.rl.evaluation import read_evaluations
+from roto.rl.runner import CHECKPOINT_DIR, Trainer
+from roto.rl.settings import TrainSettings
+
+
+def code_commit() -> str:
+    """The checked-out commit (short hash), or "unknown" outside a git checkout."""
+    out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=False)
+    return out.stdout.strip() or "unknown"
+
+
+def summary_path(results: pathlib.Path, cell: Cell) -> pathlib.Path:
+    """Where a finished cell's summary is."""
+    return results / f"{cell.name}.json"
+
+
+def new_trainer(plan: Plan, cell: Cell, run_dir: pathlib.Path, env_factory: Callable[[EnvConfig], Any]) -> Trainer:
+    """The cell's trainer before any update: the plan's envs, the variant's agent for the task."""
+    env = EnvConfig(task=cell.task, robot=cell.robot, obs_mode=cell.obs, num_envs=plan.num_envs, seed=cell.seed,
+                    threads=plan.threads, backend=plan.backend, device=plan.device)  # fmt: skip
+    agent = load_agent_config(cell.task, *plan.variants[cell.variant].agent_for(cell.task))
+    return Trainer(TrainSettings(env=env, total_steps=plan.steps), agent, run_dir, env_factory=env_factory)
+
+
+def run_cell(
+    plan: Plan,
+    cell: Cell,
+    run_dir: pathlib.Path,
+    results: pathlib.Path,
+    commit: str,
+    env_factory: Callable[[EnvConfig], Any] = RotoEnv,
+) -> dict[str, Any]:
+    """Train (or continue) the cell, evaluate it, write and return its summary."""
+    if (run_dir / CHECKPOINT_DIR / "latest.pt").is_file():
+        trainer = Trainer.resume(run_dir, env_factory=env_factory)
+    else:
+        trainer = new_trainer(plan, cell, run_dir, env_factory)
+    try:
+        trainer.train(progress=False)
+    finally:
+        trainer.env.close()
+        trainer.evaluator.env.close()
+    final = copy.deepcopy(trainer.model).cpu().eval()
+    best = copy.deepcopy(final)
+    best.load_state_dict(load_checkpoint(run_dir / CHECKPOINT_DIR / "best.pt")["model"])
+    records = read_evaluations(run_dir)
+    summary = {
+        **{key: getattr(cell, key) for key in ("task", "robot", "obs", "variant", "seed")},
+        "plan": plan.name,
+        "commit": commit,
+        "run_dir": str(run_dir),
+        "env_steps": trainer.env_steps,
+        "train_wall_s": trainer.train_seconds,
+        "best_update": max(records, key=lambda r: r["return_mean"])["update"],
+        "evaluations": [{k: v for k, v in r.items() if k != "per_episode"} for r in records],
+        "final": evaluate(final, trainer.settings, plan.eval_episodes, env_factory=env_factory),
+        "best": evaluate(best, trainer.settings, plan.eval_episodes, env_factory=env_factory),
+    }
+    results.mkdir(parents=True, exist_ok=True)
+    summary_path(results, cell).write_text(json.dumps(summary, indent=1))
+    return summary

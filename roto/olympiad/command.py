@@ -1,0 +1,100 @@
+"""``roto olympiad PLAN`` (train and evaluate a plan's cells) and ``roto results`` (its tables and plots)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from roto.olympiad.plan import Plan
+
+
+def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
+    """Register ``roto olympiad`` and ``roto results``."""
+    p = sub.add_parser("olympiad", help="train and evaluate a plan of hands x tasks x obs modes x agents x seeds")
+    p.add_argument("plan", help="a packaged plan (cpu, paper) or a plan YAML file")
+    p.add_argument("--root", default="runs/olympiad", help="where run directories go (<root>/<plan>/<cell>)")
+    p.add_argument("--results", default=None, help="folder of the cells' summaries (default <root>/<plan>/results)")
+    p.add_argument("--storage", default=None, help="database URL (e.g. postgresql://...); default: journal file")
+    p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
+    p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running cell's heartbeats")
+    p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
+    p.add_argument("--dry-run", "--dry_run", dest="dry_run", action="store_true",
+                   help="list the cells, which are done, and the time left; train nothing")  # fmt: skip
+    p.set_defaults(func=cmd_olympiad)
+    r = sub.add_parser("results", help="tables (markdown, CSV) and learning curves of an Olympiad's cells")
+    r.add_argument("source", help="a plan's name or file (its default results folder), or a folder of summaries")
+    r.add_argument("--out", required=True, help="folder to write results.md, results_*.csv and curves_*.png into")
+    r.add_argument("--root", default="runs/olympiad")
+    r.set_defaults(func=cmd_results)
+
+
+def _results_dir(args: argparse.Namespace, plan_name: str) -> pathlib.Path:
+    return pathlib.Path(args.results) if args.results else pathlib.Path(args.root) / plan_name / "results"
+
+
+def cmd_olympiad(args: argparse.Namespace) -> int:
+    """Run (or with --dry-run list) the plan's cells."""
+    import torch
+
+    from roto.olympiad.plan import load_plan
+    from roto.olympiad.worker import open_olympiad, run_olympiad_worker
+    from roto.sweep.claims import launch_workers
+
+    plan = load_plan(args.plan)  # checked before anything runs or is written
+    results = _results_dir(args, plan.name)
+    if args.dry_run:
+        print(dry_run_report(plan, args.root, results, args.storage))
+        return 0
+    if args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    if args.workers > 1:
+        open_olympiad(plan, args.root, args.storage)  # create the study once, so the workers only join
+        argv = [args.plan, "--root", args.root, "--results", str(results), "--heartbeat", str(args.heartbeat),
+                "--torch_threads", str(args.torch_threads)]  # fmt: skip
+        argv += ["--storage", args.storage] if args.storage else []
+        return launch_workers("olympiad", args.workers, argv)
+    torch.set_num_threads(args.torch_threads)
+    finished = run_olympiad_worker(plan, args.root, results, args.storage, args.heartbeat)
+    print(json.dumps({"plan": plan.name, "finished_by_this_worker": finished, "results": str(results)}))
+    return 0
+
+
+def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None) -> str:
+    """The cells and their status, and the time left at the throughput of the finished cells."""
+    from roto.olympiad.results import read_summaries
+    from roto.olympiad.worker import cell_status
+
+    status = cell_status(plan, root, results, storage)
+    lines = [f"plan {plan.name}: {len(plan.cells)} cells, {plan.steps} env steps each", ""]
+    lines += [f"  {name:<52} {state}" for name, state in status.items()]
+    left = sum(state != "done" for state in status.values())
+    try:
+        summaries = read_summaries(results)
+    except FileNotFoundError:
+        summaries = []
+    if summaries:
+        rate = sum(s["env_steps"] for s in summaries) / sum(s["train_wall_s"] for s in summaries)
+        hours = left * plan.steps / rate / 3600
+        estimate = f"{hours:.1f} h for one worker at {rate:.0f} env steps/s (the finished cells' throughput)"
+    else:
+        estimate = "unknown until a cell has finished (no throughput measured yet)"
+    lines += ["", f"{len(status) - left} done, {left} left; time left: {estimate}"]
+    return "\n".join(lines)
+
+
+def cmd_results(args: argparse.Namespace) -> int:
+    """Write the tables and curves."""
+    from roto.olympiad.plan import load_plan
+    from roto.olympiad.results import write_results
+
+    source = pathlib.Path(args.source)
+    if source.is_dir():
+        folder, name = source, ""
+    else:
+        name = load_plan(args.source).name
+        folder = pathlib.Path(args.root) / name / "results"
+    print(json.dumps(write_results(folder, args.out, plan=name)))
+    return 0

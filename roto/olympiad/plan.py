@@ -1,0 +1,176 @@
+"""Olympiad plans: which cells (task, robot, obs mode, agent variant, seed) to train and evaluate.
+
+A plan is a YAML file::
+
+    steps: 5000000          # env steps per cell
+    eval_episodes: 100      # episodes of the final and the best policy's evaluation
+    num_envs: 128
+    threads: 2
+    variants:               # name -> per task: agent config (a file or packaged name; null or
+      ppo:                  #   left out: the task's default) and overrides
+        bounce: {agent_cfg: bounce_cpu_quickstart, overrides: [ppo.entropy_coef=0.004]}
+        baoding: {overrides: [ppo.epochs=4]}
+    grids:                  # the cells: the union of these products
+      - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0, 1]}
+
+The packaged plans are ``cpu`` and ``paper`` (``roto/configs/olympiad``). Everything a plan names
+is checked before anything runs.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+import itertools
+import pathlib
+from dataclasses import dataclass
+from typing import Any
+
+import yaml
+
+from roto.envs.observations import OBS_MODES
+from roto.rl.build import resolve_groups
+from roto.rl.config import load_agent_config
+from roto.rl.overrides import split_overrides
+from roto.robots import ROBOTS
+from roto.sim.backend import BACKENDS
+from roto.tasks import TASKS
+
+PLAN_KEYS = {"description", "steps", "eval_episodes", "num_envs", "threads", "backend", "device", "variants", "grids"}
+VARIANT_KEYS = {"agent_cfg", "overrides"}
+"""Keys of a variant's entry for one task."""
+GRID_KEYS = {"tasks", "robots", "obs", "variants", "seeds"}
+
+
+@dataclass(frozen=True)
+class Variant:
+    """An agent: per task, its config (None: the task's default) and overrides."""
+
+    name: str
+    per_task: tuple[tuple[str, str | None, tuple[str, ...]], ...]
+    """(task, agent config, overrides) for every task the variant trains."""
+
+    def agent_for(self, task: str) -> tuple[str | None, list[str]]:
+        """(agent config, overrides) this variant trains ``task`` with."""
+        for name, agent_cfg, overrides in self.per_task:
+            if name == task:
+                return agent_cfg, list(overrides)
+        raise ValueError(
+            f"variant {self.name!r} has no config for task {task!r}; it has {[t[0] for t in self.per_task]}"
+        )
+
+
+@dataclass(frozen=True, order=True)
+class Cell:
+    """One run of the Olympiad."""
+
+    task: str
+    robot: str
+    obs: str
+    variant: str
+    seed: int
+
+    @property
+    def name(self) -> str:
+        """``<task>-<robot>-<obs>-<variant>-seed<k>``: the run directory's and the summary's name."""
+        return f"{self.task}-{self.robot}-{self.obs}-{self.variant}-seed{self.seed}"
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A checked plan."""
+
+    name: str
+    steps: int
+    eval_episodes: int
+    num_envs: int
+    threads: int
+    variants: dict[str, Variant]
+    cells: tuple[Cell, ...]
+    backend: str = "cpu"
+    device: str = "cpu"
+    description: str = ""
+
+
+def packaged_plans() -> dict[str, pathlib.Path]:
+    """{name: path} of the plans shipped in ``roto/configs/olympiad``."""
+    folder = importlib.resources.files("roto") / "configs" / "olympiad"
+    return {pathlib.Path(str(p)).stem: pathlib.Path(str(p)) for p in folder.iterdir() if p.name.endswith(".yaml")}
+
+
+def load_plan(plan: str) -> Plan:
+    """A packaged plan by name, or a plan file; ValueError naming any unknown key, name or value."""
+    shipped = packaged_plans()
+    path = shipped.get(plan) or pathlib.Path(plan)
+    if not path.is_file():
+        raise FileNotFoundError(f"plan {plan!r} does not exist; give a YAML file or a packaged plan: {sorted(shipped)}")
+    data = yaml.safe_load(path.read_text()) or {}
+    where = f"plan {plan!r}"
+    _check_keys(data, PLAN_KEYS, where)
+    numbers = {key: data.get(key, default) for key, default in
+               (("steps", 5_000_000), ("eval_episodes", 100), ("num_envs", 128), ("threads", 1))}  # fmt: skip
+    for key, value in numbers.items():
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ValueError(f"{where}: {key} must be an integer >= 1, got {value!r}")
+    variants = {
+        name: _variant(name, spec, f"{where}: variant {name!r}") for name, spec in (data.get("variants") or {}).items()
+    }
+    # in the plan's order, seed-major: every cell gets its first seed before any gets a second
+    listed = [
+        cell
+        for i, grid in enumerate(data.get("grids") or [])
+        for cell in _grid_cells(grid, variants, f"{where}: grids[{i}]")
+    ]
+    cells = sorted(dict.fromkeys(listed), key=lambda cell: cell.seed)
+    if not cells:
+        raise ValueError(f"{where} has no cells: give at least one grid with tasks, robots, obs, variants, seeds")
+    backend, device = str(data.get("backend", "cpu")), str(data.get("device", "cpu"))
+    if backend not in BACKENDS:
+        raise ValueError(f"{where}: unknown backend {backend!r}; valid backends: {list(BACKENDS)}")
+    return Plan(name=path.stem, variants=variants, cells=tuple(cells), backend=backend, device=device,
+                description=str(data.get("description", "")), **numbers)  # fmt: skip
+
+
+def _check_keys(data: Any, valid: set[str], where: str) -> None:
+    if not isinstance(data, dict):
+        raise ValueError(f"{where} must be a mapping, got {data!r}")
+    unknown = sorted(set(data) - valid)
+    if unknown:
+        raise ValueError(f"{where}: unknown keys {unknown}; valid keys: {sorted(valid)}")
+
+
+def _variant(name: str, spec: Any, where: str) -> Variant:
+    _check_keys(spec, set(TASKS), where)
+    per_task = []
+    for task, entry in spec.items():
+        _check_keys(entry or {}, VARIANT_KEYS, f"{where}, task {task!r}")
+        overrides = tuple((entry or {}).get("overrides") or ())
+        env_changes, _ = split_overrides(list(overrides))
+        if env_changes:
+            raise ValueError(f"{where}: env overrides {sorted(env_changes)} belong to the plan, not a variant")
+        per_task.append((task, (entry or {}).get("agent_cfg"), overrides))
+    return Variant(name, tuple(per_task))
+
+
+def _grid_cells(grid: Any, variants: dict[str, Variant], where: str) -> list[Cell]:
+    _check_keys(grid, GRID_KEYS, where)
+    valid = {"tasks": sorted(TASKS), "robots": sorted(ROBOTS), "obs": list(OBS_MODES), "variants": sorted(variants)}
+    for key in GRID_KEYS:
+        values = grid.get(key)
+        if not isinstance(values, list) or not values:
+            raise ValueError(f"{where}: {key} must be a non-empty list, got {values!r}")
+        for value in values if key != "seeds" else ():
+            if value not in valid[key]:
+                raise ValueError(f"{where}: unknown {key[:-1] if key != 'obs' else 'obs mode'} {value!r}; "
+                                 f"valid {key}: {valid[key]}")  # fmt: skip
+    for seed in grid["seeds"]:
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise ValueError(f"{where}: seeds must be integers >= 0, got {seed!r}")
+    for task, obs, name in itertools.product(grid["tasks"], grid["obs"], grid["variants"]):
+        try:  # the variant's config must load for this task and obs mode (groups included)
+            resolve_groups(load_agent_config(task, *variants[name].agent_for(task)), obs)
+        except (ValueError, FileNotFoundError) as error:
+            raise ValueError(f"{where}: variant {name!r} on {task}/{obs}: {error}") from None
+    return [
+        Cell(*values)
+        for values in itertools.product(grid["tasks"], grid["robots"], grid["obs"], grid["variants"], grid["seeds"])
+    ]

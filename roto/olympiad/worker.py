@@ -1,0 +1,120 @@
+"""Olympiad workers: cells handed out through an Optuna study, on one machine or many.
+
+Each cell is a trial enqueued in the study ``olympiad-<plan>`` (the journal in ``<root>/<plan>``
+or a database, as for sweeps, ``roto.sweep.storage``), its name in the trial's ``cell`` user
+attribute. A worker enqueues every cell that has neither a summary nor a live trial, then asks the
+study for waiting trials until none is left. A worker that dies leaves its trial without a
+heartbeat; the next worker to look fails it and enqueues a retry, which continues the cell's run
+from its latest checkpoint. Should a cell be enqueued twice (workers starting at once), the trial
+with the higher number sees the other running or complete and ends as a duplicate: no cell trains
+twice.
+"""
+
+from __future__ import annotations
+
+import pathlib
+from collections.abc import Callable
+from typing import Any
+
+import optuna
+from optuna.trial import TrialState
+
+from roto.envs.roto_env import RotoEnv
+from roto.olympiad.cell import code_commit, run_cell, summary_path
+from roto.olympiad.plan import Cell, Plan
+from roto.sweep.claims import run_claimed, tell_failed
+from roto.sweep.storage import JOURNAL_NAME, fail_stale_trials, open_storage
+
+CELL_ATTR = "cell"
+LIVE = (TrialState.COMPLETE, TrialState.RUNNING, TrialState.WAITING)
+
+
+def study_name(plan: Plan) -> str:
+    """The Optuna study that hands out ``plan``'s cells."""
+    return f"olympiad-{plan.name}"
+
+
+def open_olympiad(plan: Plan, root: str, storage_url: str | None) -> tuple[optuna.Study, optuna.storages.BaseStorage]:
+    """The plan's study (created when missing)."""
+    storage = open_storage(pathlib.Path(root) / plan.name, storage_url)
+    study = optuna.create_study(study_name=study_name(plan), storage=storage, direction="maximize", load_if_exists=True)
+    return study, storage
+
+
+def cell_trials(study: optuna.Study, states: tuple[TrialState, ...]) -> dict[str, list[optuna.trial.FrozenTrial]]:
+    """{cell name: its trials in ``states``}."""
+    found: dict[str, list] = {}
+    for trial in study.get_trials(deepcopy=False, states=states):
+        if CELL_ATTR in trial.user_attrs:
+            found.setdefault(trial.user_attrs[CELL_ATTR], []).append(trial)
+    return found
+
+
+def enqueue_missing(study: optuna.Study, plan: Plan, results: pathlib.Path) -> list[Cell]:
+    """Enqueue every cell without a summary and without a live trial; the cells enqueued."""
+    live = cell_trials(study, LIVE)
+    missing = [c for c in plan.cells if c.name not in live and not summary_path(results, c).is_file()]
+    for cell in missing:
+        study.enqueue_trial({}, user_attrs={CELL_ATTR: cell.name})
+    return missing
+
+
+def is_duplicate(study: optuna.Study, number: int, cell: str) -> bool:
+    """Whether a lower-numbered trial of ``cell`` runs or has finished (that one keeps the cell)."""
+    others = cell_trials(study, (TrialState.COMPLETE, TrialState.RUNNING)).get(cell, [])
+    return any(t.number < number or t.state == TrialState.COMPLETE for t in others)
+
+
+def run_olympiad_worker(
+    plan: Plan,
+    root: str = "runs/olympiad",
+    results: str | pathlib.Path | None = None,
+    storage_url: str | None = None,
+    heartbeat: float = 30.0,
+    env_factory: Callable[[Any], Any] = RotoEnv,
+) -> int:
+    """Train cells until none is waiting; the number this worker finished."""
+    results = pathlib.Path(results) if results is not None else pathlib.Path(root) / plan.name / "results"
+    study, storage = open_olympiad(plan, root, storage_url)
+    enqueue_missing(study, plan, results)
+    cells = {cell.name: cell for cell in plan.cells}
+    commit = code_commit()  # the code this worker trains with, read before the checkout can move on
+    finished = 0
+    while True:
+        fail_stale_trials(study, storage, grace=4 * heartbeat)
+        if not study.get_trials(deepcopy=False, states=(TrialState.WAITING,)):
+            return finished
+        trial = study.ask()
+        name = trial.user_attrs.get(CELL_ATTR)
+        if name not in cells:  # another worker took the last waiting cell: this is a fresh, empty trial
+            tell_failed(study, trial, "surplus: no cell was waiting")
+            continue
+        if is_duplicate(study, trial.number, name):
+            tell_failed(study, trial, f"duplicate: another trial has cell {name}")
+            continue
+        run_dir = pathlib.Path(root) / plan.name / name
+
+        def work(_: dict, cell: Cell = cells[name], run_dir: pathlib.Path = run_dir) -> float:
+            summary = run_cell(plan, cell, run_dir, results, commit, env_factory)
+            return summary["final"]["return_mean"]
+
+        finished += run_claimed(study, storage, trial, heartbeat, work)
+
+
+def cell_status(plan: Plan, root: str, results: pathlib.Path, storage_url: str | None) -> dict[str, str]:
+    """{cell name: done, running, waiting, failed or not started} without creating anything."""
+    status = {c.name: ("done" if summary_path(results, c).is_file() else "not started") for c in plan.cells}
+    if storage_url is None and not (pathlib.Path(root) / plan.name / JOURNAL_NAME).is_file():
+        return status
+    storage = open_storage(pathlib.Path(root) / plan.name, storage_url)
+    names = [s.study_name for s in optuna.get_all_study_summaries(storage, include_best_trial=False)]
+    if study_name(plan) not in names:
+        return status
+    study = optuna.load_study(study_name=study_name(plan), storage=storage)
+    by_state = (("failed", (TrialState.FAIL,)), ("waiting", (TrialState.WAITING,)),
+                ("running", (TrialState.RUNNING,)), ("done", (TrialState.COMPLETE,)))  # fmt: skip
+    for label, states in by_state:  # later labels win: a cell failed once and now running is running
+        for name in cell_trials(study, states):
+            if name in status and status[name] != "done":
+                status[name] = label
+    return status

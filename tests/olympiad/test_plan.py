@@ -1,0 +1,74 @@
+import pytest
+
+from roto.olympiad.plan import load_plan, packaged_plans
+
+
+def test_packaged_plans():
+    assert set(packaged_plans()) == {"cpu", "paper"}
+    cpu = load_plan("cpu")
+    names = [c.name for c in cpu.cells]
+    assert len(names) == 16 and cpu.steps == 5_000_000 and cpu.eval_episodes == 100
+    assert sum(n.startswith("bounce-") and "-blind-" in n for n in names) == 8  # 4 hands x 2 seeds
+    assert sum(n.startswith("baoding-") for n in names) == 4  # 4 hands x 1 seed
+    assert {n for n in names if "-blind-" not in n} == {
+        f"bounce-shadow-{obs}-ppo-seed{s}" for obs in ("state", "proprio") for s in (0, 1)
+    }
+    assert [c.seed for c in cpu.cells] == sorted(c.seed for c in cpu.cells)  # every first seed before a second
+    paper = load_plan("paper")
+    assert len(paper.cells) == 4 * 2 * 2 * 5 and paper.steps == 200_000_000 and paper.backend == "warp"
+
+
+GRID = "grids:\n  - {tasks: [bounce], robots: [shadow], obs: [blind], variants: [ppo], seeds: [0]}\n"
+VARIANTS = "variants:\n  ppo:\n    bounce: {agent_cfg: bounce_cpu_quickstart}\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (VARIANTS + GRID.replace("[shadow]", "[shadow, r2d2]"), r"unknown robot 'r2d2'; valid robots: \['allegro'"),
+        (VARIANTS + GRID.replace("[bounce]", "[juggle]"), r"unknown task 'juggle'; valid tasks: \['baoding'"),
+        (VARIANTS + GRID.replace("[blind]", "[xray]"), r"unknown obs mode 'xray'; valid obs: \['blind'"),
+        (VARIANTS + GRID.replace("[ppo]", "[sac]"), r"unknown variant 'sac'; valid variants: \['ppo'\]"),
+        (VARIANTS + GRID.replace("[0]", "[-1]"), r"seeds must be integers >= 0, got -1"),
+        (VARIANTS + GRID + "stepz: 10\n", r"unknown keys \['stepz'\]; valid keys: \["),
+        (VARIANTS + GRID + "backend: physx\n", r"unknown backend 'physx'; valid backends: \['cpu', 'warp'\]"),
+        (VARIANTS.replace("bounce:", "baoding:") + GRID, r"variant 'ppo' has no config for task 'bounce'"),
+        (VARIANTS.replace("quickstart}", "quickstart, overrides: [ppo.lrr=1]}") + GRID, r"key 'ppo.lrr'"),
+        (VARIANTS.replace("bounce_cpu_quickstart", "bounce_fd") + GRID, r"packaged config: \['baoding'"),
+        (VARIANTS, r"has no cells"),
+    ],
+)  # fmt: skip
+def test_a_bad_plan_is_rejected_naming_the_valid_choices(tmp_path, text, message):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises((ValueError, FileNotFoundError), match=message):
+        load_plan(str(path))
+
+
+def test_cli_rejects_a_bad_plan_before_anything_runs(tmp_path, capsys):
+    from roto.cli import main
+
+    path = tmp_path / "bad.yaml"
+    path.write_text(VARIANTS + GRID.replace("[shadow]", "[r2d2]"))
+    assert main(["olympiad", str(path), "--root", str(tmp_path / "runs")]) == 2
+    assert "unknown robot 'r2d2'" in capsys.readouterr().err
+    assert not (tmp_path / "runs").exists()
+    assert main(["olympiad", "nope"]) == 2
+    assert "packaged plan: ['cpu', 'paper']" in capsys.readouterr().err
+
+
+def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp_path, capsys):
+    import json
+
+    from roto.cli import main
+
+    results = tmp_path / "results"
+    results.mkdir()
+    done = {"env_steps": 5_000_000, "train_wall_s": 1000.0}  # 5000 env steps/s
+    (results / "bounce-shadow-blind-ppo-seed0.json").write_text(json.dumps(done))
+    assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
+    out = capsys.readouterr().out
+    assert "bounce-shadow-blind-ppo-seed0" in out and out.count(" done\n") == 1
+    # 15 cells left x 5 M steps at 5000 env steps/s = 15000 s
+    assert "1 done, 15 left; time left: 4.2 h for one worker at 5000 env steps/s" in out
+    assert not (tmp_path / "cpu").exists()  # a dry run creates no study

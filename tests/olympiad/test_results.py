@@ -1,0 +1,53 @@
+import csv
+import json
+
+import pytest
+
+from roto.cli import main
+
+CELLS = [  # (task, robot, variant, seed, final metric, best metric)
+    *[("bounce", "shadow", "ppo", s, m, m + 1) for s, m in enumerate([10.0, 20.0, 30.0, 100.0])],
+    ("bounce", "shadow", "fd", 0, 25.0, 25.0),
+    ("bounce", "shadow", "fd", 1, 35.0, 40.0),
+    ("baoding", "allegro", "ppo", 0, 1.5, 2.0),
+]
+
+
+def write_summaries(folder):
+    folder.mkdir()
+    for task, robot, variant, seed, final, best in CELLS:
+        metric = "bounces" if task == "bounce" else "rotations"
+        curve = [{"update": u, "env_steps": 1000 * u, "train_wall_s": 2.0 * u, "return_mean": final * u,
+                  f"{metric}_mean": final * u / 2} for u in (1, 2)]  # fmt: skip
+        summary = {"task": task, "robot": robot, "obs": "blind", "variant": variant, "seed": seed, "plan": "toy",
+                   "commit": "abc1234", "env_steps": 2000, "train_wall_s": 4.0, "evaluations": curve,
+                   "final": {f"{metric}_mean": final}, "best": {f"{metric}_mean": best}}  # fmt: skip
+        (folder / f"{task}-{robot}-blind-{variant}-seed{seed}.json").write_text(json.dumps(summary))
+
+
+def test_results_match_hand_computed_statistics(tmp_path, capsys):
+    write_summaries(tmp_path / "summaries")
+    out = tmp_path / "out"
+    assert main(["results", str(tmp_path / "summaries"), "--out", str(out)]) == 0
+    rows = {(r["task"], r["robot"], r["variant"]): r for r in csv.DictReader((out / "results_final.csv").open())}
+    ppo = rows[("bounce", "shadow", "ppo")]
+    # 10, 20, 30, 100: mean 40, population std sqrt((900 + 400 + 100 + 3600) / 4), IQM mean of 20 and 30
+    assert float(ppo["mean"]) == 40.0 and float(ppo["std"]) == pytest.approx(1250**0.5)
+    assert float(ppo["iqm"]) == 25.0 and int(ppo["n"]) == 4 and ppo["metric"] == "bounces"
+    assert float(ppo["iqm_ci95_low"]) <= 25.0 <= float(ppo["iqm_ci95_high"])
+    assert float(rows[("baoding", "allegro", "ppo")]["mean"]) == 1.5  # rotations, one seed
+    best = {(r["task"], r["variant"]): r for r in csv.DictReader((out / "results_best.csv").open())}
+    assert float(best[("bounce", "fd")]["mean"]) == 32.5
+    md = (out / "results.md").read_text()
+    assert "plan toy, commit abc1234" in md
+    assert "| shadow | " in md and "40.0 ± 35.4 (IQM 25.0" in md and "| 27.9 |" in md  # scripted Bounce beside
+    # roto v1's figures where the variant is roto's: baoding / blind / ppo, bounce / blind / ppo (not "fd")
+    assert "| roto v1, Shadow, 200 M steps (5 seeds) | 5.1 |  | 69.0 |  |" in md
+    # P(fd > ppo) on Shadow Bounce: 25 beats 10 and 20, 35 beats 10, 20 and 30: 5 of 8 pairs
+    assert "bounce / shadow / blind: P(fd > ppo) = 0.62" in md
+    assert (out / "curves_bounce_shadow.png").stat().st_size > 0 and (out / "curves_baoding_allegro.png").is_file()
+
+
+def test_results_of_a_folder_without_summaries_is_a_clear_error(tmp_path, capsys):
+    assert main(["results", str(tmp_path), "--out", str(tmp_path / "out")]) == 2
+    assert "no cell summaries" in capsys.readouterr().err

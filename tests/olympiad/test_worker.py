@@ -1,0 +1,97 @@
+import json
+import multiprocessing
+import os
+import signal
+import time
+
+import optuna
+from optuna.trial import TrialState
+
+from roto.olympiad.plan import load_plan
+from roto.olympiad.worker import CELL_ATTR, cell_status, study_name
+from roto.rl.evaluation import read_evaluations
+from roto.sweep.storage import REASON_ATTR, open_storage
+from tests.olympiad.toy_plan import toy_worker, write_toy_plan
+
+
+def load_study(root, plan):
+    return optuna.load_study(study_name=study_name(plan), storage=open_storage(root / plan.name))
+
+
+def test_two_workers_finish_every_cell_once(tmp_path):
+    plan_path = write_toy_plan(tmp_path)
+    plan, root = load_plan(str(plan_path)), tmp_path / "runs"
+    assert len(plan.cells) == 8  # 2 tasks x 2 robots x 1 obs x 1 variant x 2 seeds
+    context = multiprocessing.get_context("spawn")
+    workers = [context.Process(target=toy_worker, args=(plan_path, root)) for _ in range(2)]
+    for worker in workers:
+        worker.start()
+    for worker in workers:
+        worker.join(timeout=300)
+        assert worker.exitcode == 0
+    study = load_study(root, plan)
+    complete = [t.user_attrs[CELL_ATTR] for t in study.get_trials(states=(TrialState.COMPLETE,))]
+    assert sorted(complete) == sorted(c.name for c in plan.cells)  # every cell once, none twice
+    others = [t for t in study.trials if t.state != TrialState.COMPLETE]
+    assert all(t.user_attrs[REASON_ATTR].startswith(("surplus", "duplicate")) for t in others)
+    results = root / plan.name / "results"
+    for cell in plan.cells:
+        summary = json.loads((results / f"{cell.name}.json").read_text())
+        assert summary["env_steps"] == plan.steps and summary["seed"] == cell.seed
+        assert summary["final"]["episodes"] == plan.eval_episodes == len(summary["best"]["per_episode"]["return"])
+        assert summary["evaluations"] == [
+            {k: v for k, v in r.items() if k != "per_episode"} for r in read_evaluations(root / plan.name / cell.name)
+        ]
+    assert set(cell_status(plan, str(root), results, None).values()) == {"done"}
+    # rerunning skips finished cells, with the journal or (another sitting) from the summaries alone
+    assert toy_worker(plan_path, root) == 0
+    (root / plan.name / "journal.log").unlink()
+    assert toy_worker(plan_path, root) == 0
+
+
+def test_a_killed_workers_cell_is_resumed_from_its_checkpoint(tmp_path):
+    plan_path = write_toy_plan(tmp_path, updates=60, seeds=(0,))
+    plan, root = load_plan(str(plan_path)), tmp_path / "runs"
+    worker = multiprocessing.get_context("spawn").Process(target=toy_worker, args=(plan_path, root, 0.5))
+    worker.start()
+    first = root / plan.name / plan.cells[0].name
+    deadline = time.time() + 120
+    while len(read_evaluations(first)) < 2:
+        assert time.time() < deadline and worker.is_alive()
+        time.sleep(0.2)
+    os.kill(worker.pid, signal.SIGKILL)
+    worker.join()
+    killed_at = len(read_evaluations(first))
+    time.sleep(2.5)  # four missed heartbeats
+
+    assert toy_worker(plan_path, root, 0.5) == len(plan.cells)
+    study = load_study(root, plan)
+    dead = study.trials[0]
+    assert dead.state == TrialState.FAIL and "no heartbeat" in dead.user_attrs[REASON_ATTR]
+    retry = [t for t in study.trials if t.system_attrs.get("failed_trial") == dead.number]
+    assert len(retry) == 1 and retry[0].state == TrialState.COMPLETE
+    assert retry[0].user_attrs[CELL_ATTR] == dead.user_attrs[CELL_ATTR] == plan.cells[0].name
+    steps = [r["env_steps"] for r in read_evaluations(first)]
+    assert steps == sorted(set(steps)) and len(steps) > killed_at and steps[-1] == plan.steps  # resumed
+
+
+def test_cli_olympiad_with_two_workers_on_the_real_env_then_results(tmp_path, capsys):
+    from roto.cli import main
+    from tests.olympiad.toy_plan import TINY
+
+    plan_path = tmp_path / "real.yaml"
+    tiny = "[" + ", ".join(f"'{o}'" for o in TINY) + "]"
+    plan_path.write_text(
+        f"steps: 16\neval_episodes: 2\nnum_envs: 2\nvariants:\n  ppo:\n    bounce: {{overrides: {tiny}}}\n"
+        "grids:\n  - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0]}\n"
+    )
+    root = tmp_path / "runs"
+    assert main(["olympiad", str(plan_path), "--root", str(root), "--workers", "2"]) == 0
+    results = root / "real" / "results"
+    assert sorted(p.name for p in results.glob("*.json")) == [
+        "bounce-allegro-blind-ppo-seed0.json", "bounce-shadow-blind-ppo-seed0.json"
+    ]  # fmt: skip
+    summary = json.loads((results / "bounce-shadow-blind-ppo-seed0.json").read_text())
+    assert summary["final"]["episodes"] == 2 and "bounces_mean" in summary["best"]
+    assert main(["results", str(plan_path), "--root", str(root), "--out", str(tmp_path / "out")]) == 0
+    assert "| allegro | " in (tmp_path / "out" / "results.md").read_text()
