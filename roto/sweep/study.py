@@ -32,7 +32,8 @@ class SweepSettings:
     """``section.key=value`` overrides every trial gets (env and agent keys) under the searched ones."""
     space: str = "roto2"
     trials: int = 40
-    """Trials that finish (complete or pruned); failed ones are retried or replaced."""
+    """Trials that finish (complete or pruned); failed ones are retried or replaced. Not part of the
+    study's identity: rerunning with a larger count extends the study."""
     startup: int = 8
     """Random start-up trials of the TPE sampler; the pruner also waits for this many trials."""
     steps: int = 2_500_000
@@ -69,7 +70,7 @@ class SweepSettings:
 
     def identity(self) -> dict[str, Any]:
         """The settings that define the study's trials (stored on the study, checked on joining)."""
-        keep = ("task", "robot", "obs", "agent_cfg", "overrides", "space", "trials", "steps", "num_envs")
+        keep = ("task", "robot", "obs", "agent_cfg", "overrides", "space", "steps", "num_envs")
         data = {k: getattr(self, k) for k in keep}
         data["overrides"] = list(self.overrides)
         return data

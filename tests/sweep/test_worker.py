@@ -137,8 +137,15 @@ def test_diverging_trials_end_pruned_with_the_reason_and_the_study_goes_on(tmp_p
 
 def test_joining_a_study_with_other_settings_is_an_error(tmp_path):
     open_study(toy_settings(tmp_path, trials=4))
-    with pytest.raises(ValueError, match=r"exists with other settings.*trials"):
-        open_study(toy_settings(tmp_path, trials=5))
+    with pytest.raises(ValueError, match=r"exists with other settings.*'steps': \(192, 320\)"):
+        open_study(toy_settings(tmp_path, trials=4, updates=10))
+    open_study(toy_settings(tmp_path, trials=6))  # a larger trial count extends the study
+
+
+def test_rerunning_with_a_larger_count_extends_the_study(tmp_path):
+    assert run_worker(toy_settings(tmp_path, trials=2), env_factory=ToyEnv) == 2
+    assert run_worker(toy_settings(tmp_path, trials=3), env_factory=ToyEnv) == 1
+    assert len(finished_trials(toy_settings(tmp_path, trials=3))[1]) == 3
 
 
 def test_cli_sweep_needs_a_study_and_show_names_missing_ones(tmp_path, capsys):
