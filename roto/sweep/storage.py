@@ -16,6 +16,7 @@ directory from its latest checkpoint. This works the same on the journal and on 
 from __future__ import annotations
 
 import pathlib
+import sys
 import threading
 import time
 import warnings
@@ -70,6 +71,8 @@ class Heartbeat:
                 self.storage.set_trial_system_attr(self.trial_id, HEARTBEAT_ATTR, time.time())
             except UpdateFinishedTrialError:  # another worker declared this trial dead
                 return
+            except Exception as error:  # a storage hiccup: keep beating, the next write may get through
+                print(f"heartbeat of trial id {self.trial_id} not written: {error}", file=sys.stderr, flush=True)
 
 
 def fail_stale_trials(study: optuna.Study, storage: optuna.storages.BaseStorage, grace: float) -> list[int]:
