@@ -103,8 +103,9 @@ def open_study(settings: SweepSettings) -> tuple[optuna.Study, optuna.storages.B
     stored = study.user_attrs.get(SETTINGS_ATTR)
     if stored is None:
         study.set_user_attr(SETTINGS_ATTR, settings.identity())
-    elif stored != settings.identity():
-        differ = {k: (stored.get(k), v) for k, v in settings.identity().items() if stored.get(k) != v}
+        return study, storage
+    differ = {k: (stored.get(k), v) for k, v in settings.identity().items() if stored.get(k) != v}
+    if differ:
         raise ValueError(
             f"study {settings.study!r} exists with other settings (stored, given): {differ}; "
             "use another --study name or the study's settings"
