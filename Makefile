@@ -14,9 +14,9 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 # the tests also cover the Warp backend on Warp's CPU device, the learner adapters and sweeps on
-# PostgreSQL, so they need the gpu, sb3, rsl_rl, skrl and postgres extras
+# PostgreSQL and W&B logging, so they need the gpu, sb3, rsl_rl, skrl, postgres and wandb extras
 $(TEST_STAMP): $(STAMP)
-	$(VENV)/bin/python -m pip install --quiet -e '.[dev,gpu,sb3,rsl_rl,skrl,postgres]'
+	$(VENV)/bin/python -m pip install --quiet -e '.[dev,gpu,sb3,rsl_rl,skrl,postgres,wandb]'
 	touch $(TEST_STAMP)
 
 # The quick start: a blind Shadow Bounce agent on the CPU (about 15 minutes on 2 cores).

@@ -87,8 +87,9 @@ def _cmd_train(args: argparse.Namespace) -> int:
     from roto.rl.runner import Trainer, TrainSettings
 
     torch.set_num_threads(args.torch_threads)
+    wandb_project = args.wandb_project if args.logger == "wandb" else None
     if args.resume:
-        trainer = Trainer.resume(args.resume, total_steps=args.steps)
+        trainer = Trainer.resume(args.resume, total_steps=args.steps, wandb_project=wandb_project)
     else:
         env_changes, agent_overrides = split_overrides(args.overrides)
         env = EnvConfig(  # validates task / robot / obs mode / backend before anything is written
@@ -107,7 +108,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         run_dir = args.run_dir or pathlib.Path("runs") / (
             f"{args.task}_{args.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{args.seed}"
         )
-        trainer = Trainer(settings, agent, run_dir)
+        trainer = Trainer(settings, agent, run_dir, wandb_project=wandb_project)
     print(f"run directory: {trainer.run_dir}", file=sys.stderr)
     last = trainer.train(progress=not args.no_progress)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
@@ -183,6 +184,17 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
         help="torch CPU threads for the PPO update; rollouts always use one (default 1)",
     )
     p_train.add_argument("--no_progress", "--no-progress", dest="no_progress", action="store_true")
+    p_train.add_argument(
+        "--logger",
+        choices=("tensorboard", "wandb"),
+        default="tensorboard",
+        help="where the scalars go besides scalars.csv: tensorboard (default), or wandb: Weights & Biases as well "
+        "as TensorBoard (pip install -e '.[wandb]'; WANDB_MODE=offline needs no account); a resumed W&B run "
+        "keeps logging to W&B",
+    )
+    p_train.add_argument(
+        "--wandb_project", "--wandb-project", dest="wandb_project", default="roto", help="W&B project (default: roto)"
+    )
     p_train.add_argument(
         "overrides",
         nargs="*",

@@ -1,20 +1,23 @@
-"""Scalar logging to TensorBoard event files and a CSV, both in the run directory."""
+"""Scalar logging to a CSV and TensorBoard event files in the run directory, and optionally to Weights & Biases."""
 
 from __future__ import annotations
 
 import csv
 import pathlib
+from typing import Any
 
 CSV_NAME = "scalars.csv"
 
 
 class ScalarLogger:
-    """Write every scalar to ``<run_dir>/scalars.csv`` (env_steps, update, tag, value) and TensorBoard.
+    """Write every scalar to ``<run_dir>/scalars.csv`` (env_steps, update, tag, value), TensorBoard and W&B.
 
-    The CSV is appended to, so a resumed run continues the same file.
+    The CSV is appended to, so a resumed run continues the same file. ``wandb_run`` (from
+    ``roto.rl.wandb_run.open_wandb_run``) gets the same scalars at the same env steps and is
+    finished on close.
     """
 
-    def __init__(self, run_dir: pathlib.Path, tensorboard: bool = True) -> None:
+    def __init__(self, run_dir: pathlib.Path, tensorboard: bool = True, wandb_run: Any | None = None) -> None:
         self.path = run_dir / CSV_NAME
         new = not self.path.exists()
         self._file = self.path.open("a", newline="")
@@ -26,6 +29,7 @@ class ScalarLogger:
             from tensorboardX import SummaryWriter
 
             self._tb = SummaryWriter(str(run_dir / "tensorboard"))
+        self._wandb = wandb_run
 
     def log(self, scalars: dict[str, float], env_steps: int, update: int) -> None:
         """Record ``scalars`` at ``env_steps``."""
@@ -34,9 +38,13 @@ class ScalarLogger:
             if self._tb is not None:
                 self._tb.add_scalar(tag, float(value), env_steps)
         self._file.flush()
+        if self._wandb is not None:
+            self._wandb.log({tag: float(value) for tag, value in scalars.items()}, step=env_steps)
 
     def close(self) -> None:
-        """Flush and close both outputs."""
+        """Flush and close every output."""
         self._file.close()
         if self._tb is not None:
             self._tb.close()
+        if self._wandb is not None:
+            self._wandb.finish()

@@ -23,8 +23,9 @@ from roto.rl.config import AgentConfig, from_dict, to_dict
 from roto.rl.evaluation import PolicyEvaluator
 from roto.rl.logger import ScalarLogger
 from roto.rl.networks import ActorCritic
-from roto.rl.settings import TrainSettings, read_run_config, write_run_config
+from roto.rl.settings import TrainSettings, read_run_config, run_config, write_run_config
 from roto.rl.torch_threads import single_torch_thread
+from roto.rl.wandb_run import logged_wandb_project, open_wandb_run, require_wandb
 
 CHECKPOINT_DIR = "checkpoints"
 EVAL_SEED_OFFSET = 10_000
@@ -69,6 +70,8 @@ class Trainer:
         tensorboard: also write TensorBoard event files (and draw the learning curve at the end).
         env_factory: builds an env from an ``EnvConfig`` (default ``RotoEnv``); tests pass a toy env
             with the same interface.
+        wandb_project: also log the scalars to this Weights & Biases project (``roto.rl.wandb_run``);
+            None: no W&B.
     """
 
     def __init__(
@@ -78,7 +81,10 @@ class Trainer:
         run_dir: str | pathlib.Path,
         tensorboard: bool = True,
         env_factory: Callable[[EnvConfig], Any] = RotoEnv,
+        wandb_project: str | None = None,
     ) -> None:
+        if wandb_project is not None:
+            require_wandb()
         self.settings, self.agent = settings, agent
         self.run_dir = pathlib.Path(run_dir)
         extra = extra_groups(agent, settings.env.obs_mode)  # checks the groups before anything is built
@@ -102,6 +108,7 @@ class Trainer:
         self.last_eval: dict[str, float] = {}
         self.obs: dict[str, torch.Tensor] | None = None
         self.tensorboard = tensorboard
+        self.wandb_project = wandb_project
         write_run_config(self.run_dir, settings, agent)
 
     @property
@@ -126,7 +133,7 @@ class Trainer:
         """
         if self.obs is None:
             self.obs, _ = self.env.reset(seed=self.settings.env.seed)
-        logger = ScalarLogger(self.run_dir, tensorboard=self.tensorboard)
+        logger = self._open_logger()
         env = self.settings.env
         bar = tqdm(total=self.total_updates * self.steps_per_update, initial=self.env_steps, disable=not progress,
                    unit="step", desc=f"{env.task}/{env.robot}/{env.obs_mode}")  # fmt: skip
@@ -161,6 +168,13 @@ class Trainer:
 
             plot_learning_curve(self.run_dir)
         return dict(self.last_eval)
+
+    def _open_logger(self) -> ScalarLogger:
+        """The run's CSV, with TensorBoard and the W&B run as asked."""
+        wandb_run = None
+        if self.wandb_project is not None:
+            wandb_run = open_wandb_run(self.run_dir, self.wandb_project, run_config(self.settings, self.agent))
+        return ScalarLogger(self.run_dir, tensorboard=self.tensorboard, wandb_run=wandb_run)
 
     def _collect_rollout(self) -> dict[str, float]:
         """``rollouts`` steps of every training env into the learner's buffer; timings."""
@@ -247,8 +261,12 @@ class Trainer:
         total_steps: int | None = None,
         tensorboard: bool = True,
         env_factory: Callable[[EnvConfig], Any] = RotoEnv,
+        wandb_project: str | None = None,
     ) -> Trainer:
-        """A trainer continuing ``run_dir`` from its latest checkpoint (optionally with a new step budget)."""
+        """A trainer continuing ``run_dir`` from its latest checkpoint (optionally with a new step budget).
+
+        A run that logged to W&B continues its W&B run; ``wandb_project`` adds W&B to one that did not.
+        """
         run_dir = pathlib.Path(run_dir)
         settings, agent = read_run_config(run_dir)
         checkpoint = run_dir / CHECKPOINT_DIR / "latest.pt"
@@ -256,7 +274,10 @@ class Trainer:
             raise FileNotFoundError(f"no checkpoint to resume from: {str(checkpoint)!r} does not exist")
         if total_steps is not None:
             settings = TrainSettings(env=settings.env, total_steps=total_steps)
-        trainer = cls(settings, agent, run_dir, tensorboard=tensorboard, env_factory=env_factory)
+        wandb_project = logged_wandb_project(run_dir) or wandb_project
+        trainer = cls(
+            settings, agent, run_dir, tensorboard=tensorboard, env_factory=env_factory, wandb_project=wandb_project
+        )
         trainer.load_state_dict(load_checkpoint(checkpoint, trainer.device))
         return trainer
 

@@ -48,10 +48,14 @@ class TrainSettings:
         return cls(env=EnvConfig(**data["env"]), total_steps=int(data["total_steps"]))
 
 
+def run_config(settings: TrainSettings, agent: AgentConfig) -> dict[str, Any]:
+    """The resolved config of a run as a plain nested dict: {"train": settings, "agent": agent config}."""
+    return {"train": settings.to_dict(), "agent": to_dict(agent)}
+
+
 def write_run_config(run_dir: pathlib.Path, settings: TrainSettings, agent: AgentConfig) -> None:
     """The resolved config of a run (what ``--resume`` reads back)."""
-    data = {"train": settings.to_dict(), "agent": to_dict(agent)}
-    (run_dir / CONFIG_NAME).write_text(yaml.safe_dump(data, sort_keys=False))
+    (run_dir / CONFIG_NAME).write_text(yaml.safe_dump(run_config(settings, agent), sort_keys=False))
 
 
 def read_run_config(run_dir: pathlib.Path) -> tuple[TrainSettings, AgentConfig]:
