@@ -3,8 +3,9 @@
     python benchmarks/agent_variants.py bounce --steps 5000000 --seeds 0 1 --out benchmarks/results
 
 Every (variant, seed) is an ordinary run directory under ``--runs`` (``<runs>/<task>/<variant>/seed<k>``).
-The script is resumable: rerun the same command and finished runs are skipped, interrupted ones
-continue from their latest checkpoint, and missing final evaluations are done. Each run's final
+The script is resumable: rerun the same command and finished runs (those with a summary, below,
+even from another sitting) are skipped, interrupted ones continue from their latest checkpoint,
+and missing final evaluations are done. Each run's final
 policy (``latest.pt``) and best policy (``best.pt``) are evaluated over ``--episodes`` fresh
 episodes, as ``roto eval`` does. The results go to ``<out>/variants_<task>_<robot>_<obs>_<steps>k.json``
 (every figure, with the commits) and a curve of the evaluation metric per variant (mean over seeds).
@@ -168,6 +169,9 @@ def main() -> None:
     for seed in args.seeds:  # seed-major: every variant gets its first seed before any gets a second
         for variant in variants:
             run_dir = pathlib.Path(args.runs) / args.task / variant / f"seed{seed}"
+            if (folder / f"{variant}_seed{seed}.json").is_file():  # finished, maybe in another sitting
+                print(f"{args.task}/{variant}/seed{seed}: summary exists, skipped", flush=True)
+                continue
             if not args.report_only:
                 train_one(args.task, variant, seed, args)
             elif not finished(run_dir, args.steps):
