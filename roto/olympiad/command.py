@@ -40,7 +40,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     import torch
 
     from roto.olympiad.plan import load_plan
-    from roto.olympiad.worker import open_olympiad, run_olympiad_worker
+    from roto.olympiad.worker import enqueue_missing, open_olympiad, run_olympiad_worker
     from roto.sweep.claims import launch_workers
 
     plan = load_plan(args.plan)  # checked before anything runs or is written
@@ -51,7 +51,8 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.workers > 1:
-        open_olympiad(plan, args.root, args.storage)  # create the study once, so the workers only join
+        # create the study and enqueue the cells once, so the workers only join and claim
+        enqueue_missing(open_olympiad(plan, args.root, args.storage)[0], plan, results)
         argv = [args.plan, "--root", args.root, "--results", str(results), "--heartbeat", str(args.heartbeat),
                 "--torch_threads", str(args.torch_threads)]  # fmt: skip
         argv += ["--storage", args.storage] if args.storage else []

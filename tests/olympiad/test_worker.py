@@ -87,6 +87,10 @@ def test_cli_olympiad_with_two_workers_on_the_real_env_then_results(tmp_path, ca
     )
     root = tmp_path / "runs"
     assert main(["olympiad", str(plan_path), "--root", str(root), "--workers", "2"]) == 0
+    study = load_study(root, load_plan(str(plan_path)))
+    assert len(study.get_trials(states=(TrialState.COMPLETE,))) == 2
+    # the command enqueued the cells before starting its workers: none was enqueued twice
+    assert not any("duplicate" in t.user_attrs.get(REASON_ATTR, "") for t in study.trials)
     results = root / "real" / "results"
     assert sorted(p.name for p in results.glob("*.json")) == [
         "bounce-allegro-blind-ppo-seed0.json", "bounce-shadow-blind-ppo-seed0.json"
