@@ -23,7 +23,7 @@ from roto.envs.roto_env import RotoEnv
 from roto.olympiad.cell import code_commit, run_cell, summary_path
 from roto.olympiad.plan import Cell, Plan
 from roto.sweep.claims import run_claimed, tell_failed
-from roto.sweep.storage import JOURNAL_NAME, fail_stale_trials, open_storage
+from roto.sweep.storage import fail_stale_trials, find_study, open_storage
 
 CELL_ATTR = "cell"
 LIVE = (TrialState.COMPLETE, TrialState.RUNNING, TrialState.WAITING)
@@ -104,13 +104,9 @@ def run_olympiad_worker(
 def cell_status(plan: Plan, root: str, results: pathlib.Path, storage_url: str | None) -> dict[str, str]:
     """{cell name: done, running, waiting, failed or not started} without creating anything."""
     status = {c.name: ("done" if summary_path(results, c).is_file() else "not started") for c in plan.cells}
-    if storage_url is None and not (pathlib.Path(root) / plan.name / JOURNAL_NAME).is_file():
+    study = find_study(pathlib.Path(root) / plan.name, study_name(plan), storage_url)
+    if study is None:
         return status
-    storage = open_storage(pathlib.Path(root) / plan.name, storage_url)
-    names = [s.study_name for s in optuna.get_all_study_summaries(storage, include_best_trial=False)]
-    if study_name(plan) not in names:
-        return status
-    study = optuna.load_study(study_name=study_name(plan), storage=storage)
     by_state = (("failed", (TrialState.FAIL,)), ("waiting", (TrialState.WAITING,)),
                 ("running", (TrialState.RUNNING,)), ("done", (TrialState.COMPLETE,)))  # fmt: skip
     for label, states in by_state:  # later labels win: a cell failed once and now running is running

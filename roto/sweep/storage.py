@@ -48,6 +48,15 @@ def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.stor
     return JournalStorage(JournalFileBackend(str(study_dir / JOURNAL_NAME)))
 
 
+def find_study(folder: pathlib.Path, name: str, url: str | None = None) -> optuna.Study | None:
+    """Study ``name`` in ``folder``'s journal (or the database at ``url``) if it exists; creates nothing."""
+    if url is None and not (folder / JOURNAL_NAME).is_file():
+        return None
+    storage = open_storage(folder, url)
+    names = [s.study_name for s in optuna.get_all_study_summaries(storage, include_best_trial=False)]
+    return optuna.load_study(study_name=name, storage=storage) if name in names else None
+
+
 class Heartbeat:
     """A thread writing the time into a running trial's system attributes every ``interval`` s."""
 

@@ -11,7 +11,7 @@ from typing import Any
 import optuna
 
 from roto.envs.config import EnvConfig
-from roto.sweep.storage import JOURNAL_NAME, open_storage
+from roto.sweep.storage import JOURNAL_NAME, find_study, open_storage
 
 SEEDS = (0, 1, 2, 3, 4)
 """Each trial trains with one of these seeds, drawn per trial (docs/spec.md §8)."""
@@ -115,13 +115,10 @@ def open_study(settings: SweepSettings) -> tuple[optuna.Study, optuna.storages.B
 
 def load_existing_study(name: str, root: str, storage_url: str | None) -> tuple[optuna.Study, dict[str, Any]]:
     """An existing study and its stored settings (for ``export`` and ``show``)."""
-    folder = pathlib.Path(root) / name
-    if storage_url is None and not (folder / JOURNAL_NAME).is_file():
+    study = find_study(pathlib.Path(root) / name, name, storage_url)
+    if study is None and storage_url is not None:
+        raise ValueError(f"no study {name!r} in the storage {storage_url!r}")
+    if study is None:
         found = sorted(p.parent.name for p in pathlib.Path(root).glob(f"*/{JOURNAL_NAME}"))
-        raise ValueError(f"no study {name!r} under {root!r} (no {folder / JOURNAL_NAME}); studies there: {found}")
-    storage = open_storage(folder, storage_url)
-    names = [s.study_name for s in optuna.get_all_study_summaries(storage, include_best_trial=False)]
-    if name not in names:
-        raise ValueError(f"no study {name!r} in this storage; studies there: {names}")
-    study = optuna.load_study(study_name=name, storage=storage)
+        raise ValueError(f"no study {name!r} under {root!r}; studies there: {found}")
     return study, study.user_attrs.get(SETTINGS_ATTR, {})
