@@ -45,7 +45,9 @@ class Columns:
     def take(self, x: torch.Tensor) -> torch.Tensor:
         """``x[..., index]``, shape ``(*x.shape[:-1], *index.shape)``: a view of ``x`` where possible."""
         view = self._view(x)
-        return x[..., self.index] if view is None else view
+        if view is not None:
+            return view
+        return x.index_select(-1, self.index) if self.index.dim() == 1 else x[..., self.index]
 
     def put(self, x: torch.Tensor, values: torch.Tensor) -> None:
         """``x[..., index] = values`` in place (``values`` broadcast to ``take``'s shape)."""

@@ -88,7 +88,7 @@ class RotoSingleEnv(gym.Env):
         """Start a new episode."""
         super().reset(seed=seed)
         obs, _ = self.env.reset(seed=seed)
-        return {k: v[0].numpy() for k, v in obs.items()}, {}
+        return {k: v.numpy()[0] for k, v in obs.items()}, {}
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict]:
         """One control step; at the end of an episode returns the episode's last observation."""
@@ -96,16 +96,10 @@ class RotoSingleEnv(gym.Env):
         obs, reward, terminated, truncated, info = self.env.step(action)
         if "final_obs" in info:
             obs = info["final_obs"]
-        out_info = {"reward_terms": {k: float(v[0]) for k, v in info["reward_terms"].items()}}
+        out_info = {"reward_terms": {k: v.item() for k, v in info["reward_terms"].items()}}
         if "episode" in info:
-            out_info["episode"] = {k: v[0].item() for k, v in info["episode"].items()}
-        return (
-            {k: v[0].numpy() for k, v in obs.items()},
-            float(reward[0]),
-            bool(terminated[0]),
-            bool(truncated[0]),
-            out_info,
-        )
+            out_info["episode"] = {k: v.item() for k, v in info["episode"].items()}
+        return {k: v.numpy()[0] for k, v in obs.items()}, reward.item(), terminated.item(), truncated.item(), out_info
 
     def close(self) -> None:
         """Release the physics threads."""

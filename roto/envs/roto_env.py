@@ -12,7 +12,7 @@ import functools
 import math
 import operator
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NamedTuple
 
 import gymnasium as gym
 import numpy as np
@@ -26,7 +26,7 @@ from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, privileged
 from roto.envs.start_pool import StartPool, draw_valid_starts
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
-from roto.sim.backend import make_backend
+from roto.sim.backend import SimState, make_backend
 from roto.sim.host_sync import deliberate_host_sync
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
@@ -43,6 +43,24 @@ def resolve_device(device: str | torch.device) -> torch.device:
 
 DEVICE_CHECK_EVERY = 16
 """Steps between the host reads of a GPU env (pool of starts, action finiteness)."""
+
+
+class Selected(NamedTuple):
+    """The columns of a batch of n physics states that the task and the observations read."""
+
+    obs_qpos: torch.Tensor  # (n, n_obs) observed joint positions
+    obs_qvel: torch.Tensor  # (n, n_obs) their velocities
+    act_qpos: torch.Tensor  # (n, n_act) actuated joint positions
+    ball_pos: torch.Tensor  # (n, n_ball, 3) ball centres
+    ball_vel: torch.Tensor  # (n, n_ball, 3) ball linear velocities
+    ball_force: torch.Tensor  # (n, substeps, n_ball) ball-hand normal force of every substep
+    tactile_force: torch.Tensor  # (n, n_links) each tactile link's normal force, last substep
+
+
+def _is_view_of(tensor: torch.Tensor, bases: tuple[torch.Tensor, ...]) -> bool:
+    """Whether ``tensor`` shares its memory with one of ``bases`` (a view, not a copy)."""
+    ptr = tensor.untyped_storage().data_ptr()
+    return any(ptr == base.untyped_storage().data_ptr() for base in bases)
 
 
 @dataclass
@@ -95,6 +113,18 @@ class RotoEnv:
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
+        idx = self._idx
+        # (columns, source) per field of Selected; sources: 0 qpos, 1 qvel, 2 sensors, 3 last substep's
+        self._selections = (
+            (idx.obs_qpos, 0),
+            (idx.obs_qvel, 1),
+            (idx.act_qpos, 0),
+            (idx.ball_pos, 0),
+            (idx.ball_vel, 1),
+            (idx.ball_force, 2),
+            (idx.tactile_force, 3),
+        )
+        self._selected_cache: tuple | None = None
         # reading the device is free on the CPU and waits for a GPU. A sync-free step reads nothing:
         # resets run masked every step, and the pool of starts and the action check are read every
         # `check_every` steps, the pool holding enough starts for every world to reset on each of
@@ -144,13 +174,10 @@ class RotoEnv:
         self._last_action = action.to(torch.float32, copy=True)  # never alias the caller's tensor
 
         sim = self.backend.step(self._target)
-        f64 = torch.float64
-        qpos = sim.qpos.to(self.device, f64)
-        qvel = sim.qvel.to(self.device, f64)
-        sensors = sim.sensordata.to(self.device, f64)
+        selected = self._selected_of(sim)
         diverged = sim.diverged.to(self.device)
 
-        inputs = self._task_inputs(qpos, qvel, sensors)
+        inputs = self._task_inputs(selected)
         result = self.task.step(self.task_state, inputs)
         reward = functools.reduce(operator.add, result.reward_terms.values()).masked_fill(diverged, 0.0)
         self._episode.length += 1
@@ -163,7 +190,7 @@ class RotoEnv:
         terminated = result.terminated | diverged
         truncated = (self._episode.length >= self.config.episode_steps) & ~terminated
 
-        frame = self._frame(qpos, qvel, sensors[:, -1], inputs, self._target, self._last_action)
+        frame = self._frame(selected, inputs, self._target, self._last_action)
         self._stack.push(frame)
         obs = self._stack.observation()
 
@@ -283,7 +310,8 @@ class RotoEnv:
     def _ensure_starts(self, done: torch.Tensor) -> bool:
         """Make this step's resets available in the pool; whether any world finished (a host read)."""
         count = int(done.sum())
-        self._starts.ensure(count)
+        if count:
+            self._starts.ensure(count)
         return count > 0
 
     def _periodic_check(self) -> None:
@@ -302,36 +330,63 @@ class RotoEnv:
                     "actions must be finite (on a GPU they are checked every few steps, not before each one)"
                 )
 
-    def _task_inputs(self, qpos: torch.Tensor, qvel: torch.Tensor, sensors: torch.Tensor) -> TaskInputs:
-        idx = self._idx
+    def _select(self, qpos: torch.Tensor, qvel: torch.Tensor, sensors: torch.Tensor) -> Selected:
+        """The env's columns of physics states: ``qpos`` (n, nq), ``qvel`` (n, nv) and ``sensors``
+        (n, substeps, nsensordata), the last substep's being the current ones."""
+        sources = (qpos, qvel, sensors, sensors[:, -1])
+        return Selected(*(columns.take(sources[k]) for columns, k in self._selections))
+
+    def _selected_of(self, sim: SimState) -> Selected:
+        """``_select`` of a step's physics state. A backend that hands out the same tensors every
+        step (the CPU one: views of arrays it writes in place) gets the selections that are views
+        made once, as they read each step's values; only copies (a gather) are made each step."""
+        cached = self._selected_cache
+        if cached is not None and cached[0] is sim.qpos and cached[1] is sim.qvel and cached[2] is sim.sensordata:
+            selected, copies = cached[3], cached[4]
+            if not copies:
+                return selected
+            sources = (sim.qpos, sim.qvel, sim.sensordata, sim.sensordata[:, -1])
+            values = list(selected)
+            for i in copies:
+                columns, k = self._selections[i]
+                values[i] = columns.take(sources[k])
+            return Selected(*values)
+        f64 = torch.float64
+        qpos = sim.qpos.to(self.device, f64)
+        qvel = sim.qvel.to(self.device, f64)
+        sensors = sim.sensordata.to(self.device, f64)
+        selected = self._select(qpos, qvel, sensors)
+        if qpos is sim.qpos and qvel is sim.qvel and sensors is sim.sensordata:  # no conversion copied them
+            bases = (qpos, qvel, sensors)
+            copies = tuple(i for i, value in enumerate(selected) if not _is_view_of(value, bases))
+            self._selected_cache = (sim.qpos, sim.qvel, sim.sensordata, selected, copies)
+        return selected
+
+    def _task_inputs(self, selected: Selected) -> TaskInputs:
         # views of the backend's state: read before the step's resets overwrite it
-        ball_pos = idx.ball_pos.take(qpos)
-        ball_vel = idx.ball_vel.take(qvel)
-        contact = (idx.ball_force.take(sensors) > self.config.tactile_threshold).any(dim=1)
-        return TaskInputs(ball_pos=ball_pos, ball_vel=ball_vel, ball_contact=contact)
+        contact = (selected.ball_force > self.config.tactile_threshold).any(dim=1)
+        return TaskInputs(ball_pos=selected.ball_pos, ball_vel=selected.ball_vel, ball_contact=contact)
 
     def _frame(
         self,
-        qpos: torch.Tensor,
-        qvel: torch.Tensor,
-        sensors_now: torch.Tensor,
+        selected: Selected,
         inputs: TaskInputs,
         target: torch.Tensor,
         last_action: torch.Tensor,
     ) -> dict[str, torch.Tensor]:
-        """One observation frame per group from (n, ·) state tensors; NaN and inf read as 0 (a
+        """One observation frame per group from (n, ·) state selections; NaN and inf read as 0 (a
         diverged world's last frame), the tactile bits are finite by construction."""
         idx = self._idx
         groups: dict[str, torch.Tensor] = {}
         if "tactile" in self.groups:
-            groups["tactile"] = tactile_bits(idx.tactile_force.take(sensors_now), self.config.tactile_threshold)
+            groups["tactile"] = tactile_bits(selected.tactile_force, self.config.tactile_threshold)
         groups["proprio"] = proprio_frame(
-            idx.obs_qpos.take(qpos),
-            idx.obs_qvel.take(qvel),
+            selected.obs_qpos,
+            selected.obs_qvel,
             idx.obs_lo,
             idx.obs_hi,
             target,
-            idx.act_qpos.take(qpos),
+            selected.act_qpos,
             last_action,
         ).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0)
         if "privileged" in self.groups:
@@ -376,11 +431,10 @@ class RotoEnv:
         qvel = qpos.new_zeros(n, self.model.nv)
         target = idx.act_qpos.take(qpos).clone()
         sensors = self.backend.sensors_at(qpos, qvel, target).to(self.device, torch.float64)
-        inputs = TaskInputs(
-            ball_pos=idx.ball_pos.take(qpos), ball_vel=idx.ball_vel.take(qvel), ball_contact=torch.zeros(0)
-        )
+        selected = self._select(qpos, qvel, sensors[:, None])
+        inputs = TaskInputs(ball_pos=selected.ball_pos, ball_vel=selected.ball_vel, ball_contact=torch.zeros(0))
         last_action = torch.zeros(n, self.num_actions, dtype=torch.float32, device=self.device)
-        frame = self._frame(qpos, qvel, sensors, inputs, target, last_action)
+        frame = self._frame(selected, inputs, target, last_action)
         found, dist = idx.self_contact.take(sensors).unbind(-1)
         penetration = torch.where(found > 0, (-dist).clamp(min=0.0), 0.0)
         frames = {f"frame/{name}": value for name, value in frame.items()}

@@ -52,6 +52,12 @@ class MujocoCpuBackend:
         self._ctrl = np.zeros((num_worlds, substeps, model.nu))
         self._out_state = np.zeros((num_worlds, substeps, self._nstate))
         self._out_sensor = np.zeros((num_worlds, substeps, model.nsensordata))
+        self._time_lag = (substeps - 0.5) * model.opt.timestep
+        # the state arrays are only ever written in place, so tensors sharing their memory are
+        # made once; a step hands them out again (only `diverged` is fresh each step)
+        self._qpos_tensor = torch.from_numpy(self.qpos)
+        self._qvel_tensor = torch.from_numpy(self.qvel)
+        self._sensor_tensor = torch.from_numpy(self._out_sensor)
 
     @property
     def qpos(self) -> np.ndarray:
@@ -65,17 +71,20 @@ class MujocoCpuBackend:
 
     def step(self, ctrl: torch.Tensor) -> SimState:
         """Hold ``ctrl`` (B, nu) for ``substeps`` physics steps on every world, in C threads."""
-        self._ctrl[:] = ctrl.detach().cpu().to(torch.float64).numpy()[:, None, :]
+        ctrl = ctrl.detach()
+        if ctrl.dtype != torch.float64 or ctrl.device.type != "cpu":
+            ctrl = ctrl.cpu().to(torch.float64)
+        self._ctrl[:] = ctrl.numpy()[:, None, :]
         self._pool.run(self.state, self._ctrl, self._out_state, self._out_sensor, self.substeps)
-        expected_time = self.state[:, 0] + (self.substeps - 0.5) * self.model.opt.timestep
+        expected_time = self.state[:, 0] + self._time_lag
         self.state[:] = self._out_state[:, -1]
         # MuJoCo resets a world whose qpos/qvel/qacc go non-finite or huge (time restarts at 0),
         # and rollout stops stepping it; a clock that fell behind is how that shows.
         diverged = (self.state[:, 0] < expected_time) | ~np.isfinite(self.state).all(axis=1)
         return SimState(
-            qpos=torch.from_numpy(self.qpos),
-            qvel=torch.from_numpy(self.qvel),
-            sensordata=torch.from_numpy(self._out_sensor),
+            qpos=self._qpos_tensor,
+            qvel=self._qvel_tensor,
+            sensordata=self._sensor_tensor,
             diverged=torch.from_numpy(diverged),
         )
 

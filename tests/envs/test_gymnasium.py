@@ -1,6 +1,7 @@
 import gymnasium as gym
 import numpy as np
 import pytest
+import torch
 from gymnasium.utils.env_checker import check_env
 
 import roto
@@ -46,3 +47,31 @@ def test_vector_env_contract_same_step_autoreset():
     for i in np.flatnonzero(done):
         assert envs.single_observation_space.contains(info["final_obs"][i])
     envs.close()
+
+
+@pytest.mark.parametrize(("task", "robot"), [("bounce", "shadow"), ("baoding", "orca")])
+def test_single_env_follows_the_batched_env_with_one_world(task, robot):
+    single = gym.make(gym_id(task, robot), obs_mode="state")
+    batched = roto.make(task, robot=robot, num_envs=1, obs_mode="state")
+    obs, _ = single.reset(seed=4)
+    ref, _ = batched.reset(seed=4)
+    rng = np.random.default_rng(0)
+    episodes = 0
+    for _ in range(300):
+        for name in ref:
+            np.testing.assert_array_equal(obs[name], ref[name][0].numpy())
+        action = rng.uniform(-1.0, 1.0, single.action_space.shape).astype(np.float32)
+        obs, reward, terminated, truncated, info = single.step(action)
+        ref, ref_reward, ref_terminated, ref_truncated, ref_info = batched.step(torch.from_numpy(action)[None])
+        assert (reward, terminated, truncated) == (ref_reward.item(), ref_terminated.item(), ref_truncated.item())
+        assert info["reward_terms"] == {k: v.item() for k, v in ref_info["reward_terms"].items()}
+        if terminated or truncated:
+            episodes += 1
+            assert info["episode"] == {k: v.item() for k, v in ref_info["episode"].items()}
+            for name in ref:  # the single env returns the episode's last observation
+                np.testing.assert_array_equal(obs[name], ref_info["final_obs"][name][0].numpy())
+            obs, _ = single.reset()
+            ref, _ = batched.reset()
+    assert episodes >= 1  # an episode's end and the reset after it were compared too
+    single.close()
+    batched.close()

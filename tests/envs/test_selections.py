@@ -1,0 +1,42 @@
+"""The env's cached column selections (views of the CPU backend's state, made once) against the
+slow reference: selections made afresh from copies of the same state, every step."""
+
+import pytest
+import torch
+
+from roto.envs.roto_env import Selected
+from roto.registry import list_envs, make
+
+
+@pytest.mark.parametrize(("task", "robot"), list_envs())
+def test_cached_selections_read_each_steps_state(task, robot):
+    env = make(task, robot=robot, num_envs=3, seed=0)
+    env.reset(seed=0)
+    gen = torch.Generator().manual_seed(0)
+    first = None
+    for _ in range(40):
+        action = torch.rand(3, env.num_actions, generator=gen, dtype=torch.float64) * 2 - 1
+        sim = env.backend.step(action * 0.2 + env._target)
+        cached = env._selected_of(sim)
+        reference = env._select(sim.qpos.clone(), sim.qvel.clone(), sim.sensordata.clone())
+        for name, got, want in zip(Selected._fields, cached, reference, strict=True):
+            assert torch.equal(got, want), name
+        first = first or cached
+    # the views were made once and reused (only gathered columns are made again)
+    _, copies = env._selected_cache[3], env._selected_cache[4]
+    for i, name in enumerate(Selected._fields):
+        if i not in copies:
+            assert cached[i] is first[i], name
+    assert len(copies) < len(Selected._fields)
+    env.close()
+
+
+def test_a_backend_that_copies_gets_fresh_selections_each_step():
+    env = make("bounce", robot="shadow", num_envs=2, seed=0)
+    env.reset(seed=0)
+    sim = env.backend.step(env._target)
+    float32_sim = type(sim)(sim.qpos.float(), sim.qvel.float(), sim.sensordata.float(), sim.diverged)
+    env._selected_cache = None
+    env._selected_of(float32_sim)
+    assert env._selected_cache is None  # converted copies are never cached
+    env.close()
