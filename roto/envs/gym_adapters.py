@@ -13,6 +13,7 @@ import torch
 from gymnasium.vector.utils import batch_space
 
 from roto.envs.roto_env import RotoEnv
+from roto.envs.single_world import SingleWorldStep, single_world_result, supports_single_world_step
 from roto.registry import make
 
 
@@ -83,6 +84,8 @@ class RotoSingleEnv(gym.Env):
         self.env = make(task, robot=robot, num_envs=1, **kwargs)
         self.observation_space = self.env.observation_space
         self.action_space = self.env.action_space
+        # numpy glue around the task's rule where the env allows it: the same trajectories, faster
+        self._fast_step = SingleWorldStep(self.env) if supports_single_world_step(self.env) else None
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict]:
         """Start a new episode."""
@@ -92,14 +95,9 @@ class RotoSingleEnv(gym.Env):
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict]:
         """One control step; at the end of an episode returns the episode's last observation."""
-        action = _action_tensor(action, self.env).reshape(1, -1)
-        obs, reward, terminated, truncated, info = self.env.step(action)
-        if "final_obs" in info:
-            obs = info["final_obs"]
-        out_info = {"reward_terms": {k: v.item() for k, v in info["reward_terms"].items()}}
-        if "episode" in info:
-            out_info["episode"] = {k: v.item() for k, v in info["episode"].items()}
-        return {k: v.numpy()[0] for k, v in obs.items()}, reward.item(), terminated.item(), truncated.item(), out_info
+        if self._fast_step is not None:
+            return self._fast_step.step(action)
+        return single_world_result(*self.env.step(_action_tensor(action, self.env).reshape(1, -1)))
 
     def close(self) -> None:
         """Release the physics threads."""

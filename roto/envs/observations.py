@@ -30,6 +30,21 @@ def tactile_bits(contact_force: torch.Tensor, threshold: float) -> torch.Tensor:
     return (contact_force > threshold).to(torch.float32)
 
 
+def proprio_parts(qpos, qvel, lo, hi, target, actuated_qpos, velocity_scale: float = JOINT_VELOCITY_SCALE):
+    """The computed parts of proprioception, with arithmetic operators only, so that numpy arrays
+    and torch tensors both work: normalised positions, scaled velocities, command error.
+
+    Args:
+        qpos: (B, n_obs) observed joint positions; qvel: (B, n_obs) their velocities.
+        lo, hi: (n_obs,) their limits.
+        target: (B, n_act) joint targets; actuated_qpos: (B, n_act) actuated joint positions.
+
+    Returns:
+        ((B, n_obs) positions in [-1, 1] within the limits, (B, n_obs) velocities, (B, n_act) errors).
+    """
+    return (2.0 * qpos - hi - lo) / (hi - lo), qvel * velocity_scale, target - actuated_qpos
+
+
 def proprio_frame(
     qpos: torch.Tensor,
     qvel: torch.Tensor,
@@ -40,21 +55,14 @@ def proprio_frame(
     last_action: torch.Tensor,
     velocity_scale: float = JOINT_VELOCITY_SCALE,
 ) -> torch.Tensor:
-    """Proprioception: normalised positions, scaled velocities, command error, last action.
-
-    Args:
-        qpos: (B, n_obs) observed joint positions; qvel: (B, n_obs) their velocities.
-        lo, hi: (n_obs,) their limits.
-        target: (B, n_act) joint targets; actuated_qpos: (B, n_act) actuated joint positions.
-        last_action: (B, n_act) raw policy action of this step.
+    """Proprioception: normalised positions, scaled velocities, command error, last action
+    (``proprio_parts`` and the raw policy action ``last_action`` (B, n_act) of this step).
 
     Returns:
         (B, 2·n_obs + 2·n_act) float32.
     """
-    pos = (2.0 * qpos - hi - lo) / (hi - lo)
-    return torch.cat([pos, qvel * velocity_scale, target - actuated_qpos, last_action.to(pos.dtype)], dim=-1).to(
-        torch.float32
-    )
+    pos, vel, error = proprio_parts(qpos, qvel, lo, hi, target, actuated_qpos, velocity_scale)
+    return torch.cat([pos, vel, error, last_action.to(pos.dtype)], dim=-1).to(torch.float32)
 
 
 def privileged_frame(ball_pos: torch.Tensor, ball_vel: torch.Tensor) -> torch.Tensor:

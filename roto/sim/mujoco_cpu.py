@@ -74,19 +74,29 @@ class MujocoCpuBackend:
         ctrl = ctrl.detach()
         if ctrl.dtype != torch.float64 or ctrl.device.type != "cpu":
             ctrl = ctrl.cpu().to(torch.float64)
-        self._ctrl[:] = ctrl.numpy()[:, None, :]
-        self._pool.run(self.state, self._ctrl, self._out_state, self._out_sensor, self.substeps)
-        expected_time = self.state[:, 0] + self._time_lag
-        self.state[:] = self._out_state[:, -1]
-        # MuJoCo resets a world whose qpos/qvel/qacc go non-finite or huge (time restarts at 0),
-        # and rollout stops stepping it; a clock that fell behind is how that shows.
-        diverged = (self.state[:, 0] < expected_time) | ~np.isfinite(self.state).all(axis=1)
+        diverged = self.step_array(ctrl.numpy())
         return SimState(
             qpos=self._qpos_tensor,
             qvel=self._qvel_tensor,
             sensordata=self._sensor_tensor,
             diverged=torch.from_numpy(diverged),
         )
+
+    def step_array(self, ctrl: np.ndarray) -> np.ndarray:
+        """``step`` for a float64 array ``ctrl`` (B, nu); returns ``diverged`` (B,) bool, the new
+        state being in ``state`` and the substeps' sensor values in ``sensordata``."""
+        self._ctrl[:] = ctrl[:, None, :]
+        self._pool.run(self.state, self._ctrl, self._out_state, self._out_sensor, self.substeps)
+        expected_time = self.state[:, 0] + self._time_lag
+        self.state[:] = self._out_state[:, -1]
+        # MuJoCo resets a world whose qpos/qvel/qacc go non-finite or huge (time restarts at 0),
+        # and rollout stops stepping it; a clock that fell behind is how that shows.
+        return (self.state[:, 0] < expected_time) | ~np.isfinite(self.state).all(axis=1)
+
+    @property
+    def sensordata(self) -> np.ndarray:
+        """(B, substeps, nsensordata) view of the last step's sensor values of every substep."""
+        return self._out_sensor
 
     def set_state(self, world_ids: torch.Tensor, qpos: torch.Tensor, qvel: torch.Tensor) -> None:
         """Overwrite worlds ``world_ids`` (n,) with ``qpos`` (n, nq), ``qvel`` (n, nv), time 0."""

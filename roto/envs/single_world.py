@@ -1,0 +1,190 @@
+"""The control step of a one-world CPU env with numpy glue: the fast path of the Gymnasium ``Env``.
+
+``RotoEnv.step`` is written for B worlds on any device: some ninety small torch ops a step, each
+costing microseconds of dispatch whatever the batch size, so with one world the ops, not the
+physics, set the pace of ``gymnasium.make("roto/...")``. ``SingleWorldStep`` runs the same step
+for a one-world env on the CPU backend: the task's own rule (torch, written once for every batch
+size) on tensors that share memory with the physics state, and numpy for everything around it
+(action to joint targets, the physics call, observation frame and stack, reward and episode sums,
+terminations). The observation formulas are the env's own (``proprio_parts``), and episode ends
+go through the env's own reset. It reads and writes the env's state, so ``RotoEnv.step``,
+``reset`` and ``state_dict`` stay valid between fast steps, and its trajectories are
+bit-identical to ``RotoEnv.step``'s, the reference (tests/envs/test_single_world.py).
+"""
+
+from __future__ import annotations
+
+import functools
+import operator
+from typing import Any
+
+import numpy as np
+import torch
+
+from roto.envs.columns import Columns
+from roto.envs.observations import proprio_parts
+from roto.envs.roto_env import RotoEnv
+from roto.sim.mujoco_cpu import MujocoCpuBackend
+from roto.tasks.base import TaskInputs
+
+SingleStep = tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]
+"""(obs (k·dim,) float32 per group, reward, terminated, truncated, info) of one world."""
+
+
+def supports_single_world_step(env: RotoEnv) -> bool:
+    """Whether ``SingleWorldStep`` can run ``env``: one world on the CPU backend, CPU tensors (and
+    each ball's centre and velocity evenly spaced in qpos and qvel, as MuJoCo lays out free joints)."""
+    cpu = env.device.type == "cpu" and isinstance(env.backend, MujocoCpuBackend) and not env.sync_free_step
+    balls_as_views = env._idx.ball_pos.start is not None and env._idx.ball_vel.start is not None
+    return cpu and env.num_envs == 1 and balls_as_views
+
+
+def _finite(x: np.ndarray) -> np.ndarray:
+    """``x`` with NaN and inf set to 0, in place (``nan_to_num(nan=0, posinf=0, neginf=0)``)."""
+    np.copyto(x, 0.0, where=~np.isfinite(x))
+    return x
+
+
+class _Reader:
+    """Columns of a persistent numpy array: a view made once where they are evenly spaced, else a
+    gather each time (the same selection as ``Columns.take``)."""
+
+    def __init__(self, columns: Columns, source: np.ndarray) -> None:
+        view = columns.take(torch.from_numpy(source))
+        self._view = view.numpy() if np.shares_memory(view.numpy(), source) else None
+        self._source = source
+        self._index = columns.index.numpy()
+
+    def read(self) -> np.ndarray:
+        """The columns' current values."""
+        return self._view if self._view is not None else self._source[..., self._index]
+
+
+class SingleWorldStep:
+    """``RotoEnv.step`` of a one-world CPU env, for a numpy action, with numpy results.
+
+    ``step`` returns the Gymnasium single-env tuple: at the end of an episode the episode's last
+    observation (the world is reset within the step, as ``RotoEnv.step`` does), ``info`` with the
+    step's reward terms as floats and, at an episode's end, the episode statistics as Python scalars.
+    """
+
+    def __init__(self, env: RotoEnv) -> None:
+        if not supports_single_world_step(env):
+            raise ValueError(
+                f"SingleWorldStep needs one world on the CPU backend, got num_envs={env.num_envs}, "
+                f"device={env.device}, backend={type(env.backend).__name__}"
+            )
+        self.env = env
+        idx, backend = env._idx, env.backend
+        qpos, qvel, sensors = backend.qpos, backend.qvel, backend.sensordata
+        now = sensors[:, -1]
+        self._obs_qpos = _Reader(idx.obs_qpos, qpos)
+        self._obs_qvel = _Reader(idx.obs_qvel, qvel)
+        self._act_qpos = _Reader(idx.act_qpos, qpos)
+        self._ball_force = _Reader(idx.ball_force, sensors)
+        self._tactile_force = _Reader(idx.tactile_force, now)
+        ball_pos, ball_vel = _Reader(idx.ball_pos, qpos).read(), _Reader(idx.ball_vel, qvel).read()
+        self._ball_pos, self._ball_vel = ball_pos, ball_vel
+        # the task reads the balls through tensors that share the state's memory (ball centres and
+        # velocities are evenly spaced columns, so these are views, made once)
+        self._ball_pos_t, self._ball_vel_t = torch.from_numpy(ball_pos), torch.from_numpy(ball_vel)
+        self._obs_lo, self._obs_hi = idx.obs_lo.numpy(), idx.obs_hi.numpy()
+        self._ctrl_lo = idx.ctrl_lo.numpy()[None]
+        self._ctrl_span = (idx.ctrl_hi - idx.ctrl_lo).numpy()[None]
+        config = env.config
+        self._alpha = config.action_smoothing
+        self._episode_steps = config.episode_steps
+        self._threshold = config.tactile_threshold
+        self._num_actions = env.num_actions
+        self._done = torch.ones(1, dtype=torch.bool)
+
+    def step(self, action: Any) -> SingleStep:
+        """One control step from ``action`` (a float array of num_actions values)."""
+        env = self.env
+        array = np.asarray(action)
+        if array.dtype.kind != "f":
+            raise TypeError(f"action dtype {array.dtype} is not floating point; use float32 or float64")
+        if env._needs_reset or array.size != self._num_actions or not np.isfinite(array).all():
+            return self._reference_step(array)  # raises the env's own error
+        row = array.reshape(1, -1)
+        clamped = np.minimum(np.maximum(row.astype(np.float64), -1.0), 1.0)
+        target = self._ctrl_lo + (clamped + 1.0) * 0.5 * self._ctrl_span
+        if self._alpha != 1.0:
+            target = self._alpha * target + (1.0 - self._alpha) * env._target.numpy()
+        last_action = row.astype(np.float32)
+        env._target = torch.from_numpy(target)
+        env._last_action = torch.from_numpy(last_action)
+
+        diverged = bool(env.backend.step_array(target)[0])
+        contact = (self._ball_force.read() > self._threshold).any(axis=1)
+        inputs = TaskInputs(self._ball_pos_t, self._ball_vel_t, torch.from_numpy(contact))
+        result = env.task.step(env.task_state, inputs)
+        terms = {name: value.item() for name, value in result.reward_terms.items()}
+        reward = 0.0 if diverged else functools.reduce(operator.add, terms.values())
+        length = env._episode.length.numpy()
+        length += 1
+        env._episode.ret.numpy()[0] += reward
+        for name, value in result.reward_terms.items():
+            if name in env._term_sums:
+                env._term_sums[name].numpy()[0] += terms[name]
+            else:
+                env._term_sums[name] = value.clone()
+        terminated = diverged or result.terminated.item()
+        truncated = not terminated and int(length[0]) >= self._episode_steps
+
+        stack = env._stack._frames
+        obs = {}
+        for name, frame in self._frame(target, last_action).items():
+            frames = np.concatenate([stack[name].numpy()[:, frame.shape[-1] :], frame], axis=1)
+            stack[name] = torch.from_numpy(frames)
+            obs[name] = frames[0].copy()
+        info: dict[str, Any] = {"reward_terms": terms}
+        if terminated or truncated:
+            info["episode"] = self._reset(truncated, diverged)
+        return obs, float(np.float32(reward)), terminated, truncated, info
+
+    def _frame(self, target: np.ndarray, last_action: np.ndarray) -> dict[str, np.ndarray]:
+        """This step's observation frame, (1, dim) float32 per group, as ``RotoEnv._frame`` makes it."""
+        groups = self.env.groups
+        frame = {}
+        if "tactile" in groups:
+            frame["tactile"] = (self._tactile_force.read() > self._threshold).astype(np.float32)
+        parts = proprio_parts(
+            self._obs_qpos.read(), self._obs_qvel.read(), self._obs_lo, self._obs_hi, target, self._act_qpos.read()
+        )
+        frame["proprio"] = _finite(np.concatenate([*parts, last_action.astype(np.float64)], axis=-1).astype(np.float32))
+        if "privileged" in groups:
+            balls = np.concatenate([self._ball_pos, self._ball_vel], axis=-1).reshape(1, -1).astype(np.float32)
+            frame["privileged"] = _finite(balls)
+        return {name: frame[name] for name in groups}
+
+    def _reset(self, truncated: bool, diverged: bool) -> dict[str, Any]:
+        """Start the next episode with the env's own reset; the ended episode's statistics."""
+        env = self.env
+        env._starts.ensure(1)
+        episode = {k: v.item() for k, v in env._episode_info(torch.tensor([truncated])).items()}
+        if diverged:
+            env._nonfinite_resets += 1
+        env._stack.reset_where(env._reset_where(self._done), self._done)
+        return episode
+
+    def _reference_step(self, array: np.ndarray) -> SingleStep:
+        """``RotoEnv.step`` itself (errors raise from there)."""
+        return single_world_result(*self.env.step(torch.as_tensor(array, device=self.env.device).reshape(1, -1)))
+
+
+def single_world_result(
+    obs: dict[str, torch.Tensor],
+    reward: torch.Tensor,
+    terminated: torch.Tensor,
+    truncated: torch.Tensor,
+    info: dict[str, Any],
+) -> SingleStep:
+    """A one-world ``RotoEnv.step`` result as the single-env tuple (the episode's last observation
+    where it ended; reward terms and episode statistics as Python scalars)."""
+    if "final_obs" in info:
+        obs = info["final_obs"]
+    out_info: dict[str, Any] = {"reward_terms": {k: v.item() for k, v in info["reward_terms"].items()}}
+    if "episode" in info:
+        out_info["episode"] = {k: v.item() for k, v in info["episode"].items()}
+    return {k: v.numpy()[0] for k, v in obs.items()}, reward.item(), terminated.item(), truncated.item(), out_info
