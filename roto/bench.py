@@ -63,6 +63,7 @@ def run_bench(
     seed: int = 0,
     backend: str = "cpu",
     device: str = "cpu",
+    touch: str = "binary",
 ) -> dict[str, Any]:
     """Measure env and raw physics throughput in one run; returns the JSON-able result."""
     torch.set_num_threads(1)
@@ -75,6 +76,7 @@ def run_bench(
         threads=threads,
         backend=backend,
         device=device,
+        touch=touch,
     )
     generator = torch.Generator().manual_seed(seed)
     actions = _random_actions(generator, num_envs, env.num_actions, warmup + steps).to(env.device)
@@ -95,6 +97,7 @@ def run_bench(
         "backend": backend,
         "device": str(env.device),
         "obs_mode": obs_mode,
+        "touch": touch,
         "num_envs": num_envs,
         "threads": threads,
         "substeps": env.config.substeps,

@@ -23,6 +23,15 @@ def _add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
     parser.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; no effect")
 
 
+def _add_touch_arg(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--touch",
+        default="binary",
+        help="tactile signal per link: binary (a touch bit, the benchmark's; default) or force "
+        "(log(1 + |F| / 0.1 N) of the link's net contact force)",
+    )
+
+
 def _cmd_list(args: argparse.Namespace) -> int:
     import roto
     from roto.registry import gym_id
@@ -50,6 +59,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         seed=args.seed,
         backend=args.backend,
         device=args.device,
+        touch=args.touch,
     )
     if args.json:
         print(json.dumps(result))
@@ -101,6 +111,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
             backend=args.backend,
             device=args.device,
             threads=args.threads,
+            touch=args.touch,
         )
         env = apply_env_overrides(env, env_changes)
         settings = TrainSettings(env=env, total_steps=args.steps if args.steps is not None else 1_000_000)
@@ -157,6 +168,7 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
         "train", help="train roto's PPO agent, optionally with auxiliary losses (progress bar, logs, checkpoints)"
     )
     _add_env_args(p_train, num_envs=64)
+    _add_touch_arg(p_train)
     p_train.add_argument(
         "--obs", "--obs_mode", "--obs-mode", dest="obs", default="blind", help="blind, state or proprio"
     )
@@ -241,6 +253,7 @@ def _add_list_parser(sub: argparse._SubParsersAction) -> None:
 def _add_bench_parser(sub: argparse._SubParsersAction) -> None:
     p_bench = sub.add_parser("bench", help="env throughput vs plain physics stepping of the same model")
     _add_env_args(p_bench, num_envs=256)
+    _add_touch_arg(p_bench)
     p_bench.add_argument("--steps", type=int, default=200, help="timed control steps (default: 200)")
     p_bench.add_argument("--obs_mode", "--obs-mode", dest="obs_mode", default="blind")
     p_bench.add_argument("--json", action="store_true", help="print one JSON object")

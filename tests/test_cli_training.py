@@ -8,6 +8,7 @@ import pytest
 import yaml
 
 from roto.cli import main
+from roto.rl.runner import load_policy
 
 TINY = [
     "network.encoder=[16]",
@@ -155,3 +156,15 @@ def test_a_privileged_critic_run_evaluates_and_plays_with_its_blind_policy(tmp_p
     assert main(["eval", "--checkpoint", str(ckpt), "--episodes", "2", "--out", str(tmp_path / "e.json")]) == 0
     assert json.loads(capsys.readouterr().out.strip().splitlines()[-1])["episodes"] == 2
     assert main(["play", "--checkpoint", str(ckpt), "--video", str(tmp_path / "p.mp4"), "--video_length", "5"]) == 0
+
+
+def test_a_force_touch_run_keeps_its_touch_through_eval(tmp_path, capsys):
+    run_dir = tmp_path / "force"
+    overrides = [*TINY, "ssl.tactile_reconstruction={weight: 0.1}"]
+    args = ["train", "--num_envs", "4", "--steps", "16", "--touch", "force", "--run_dir", str(run_dir), "--no_progress"]
+    assert main([*args, *overrides]) == 0
+    assert "touch: force" in (run_dir / "config.yaml").read_text()
+    ckpt = run_dir / "checkpoints" / "best.pt"
+    assert main(["eval", "--checkpoint", str(ckpt), "--episodes", "2", "--out", str(tmp_path / "e.json")]) == 0
+    _, settings, _ = load_policy(ckpt)
+    assert settings.env.touch == "force"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib.util
 from dataclasses import dataclass
 
-from roto.envs.observations import OBS_GROUPS, OBS_MODES
+from roto.envs.observations import OBS_GROUPS, OBS_MODES, TOUCH_MODES
 from roto.sim.backend import BACKENDS
 
 
@@ -30,7 +30,9 @@ class EnvConfig:
         substeps: physics steps per control step (1/240 s each).
         episode_steps: control steps per episode (10 s at 60 Hz).
         action_smoothing: alpha of the exponential smoothing of joint targets (1 = none).
-        tactile_threshold: normal force (N) above which a link counts as touched.
+        touch: what the tactile group holds per link: ``binary`` (a touch bit, the benchmark's
+            signal) or ``force`` (log(1 + |F| / 0.1 N) of the link's net contact force).
+        tactile_threshold: normal force (N) above which a link counts as touched (binary touch).
         reset_joint_noise: half-width (rad) of the uniform noise added to the default pose at reset.
         nconmax: contacts per world the ``warp`` backend allocates (None: roto's measured figure for
             this robot and task, ``roto.envs.capacity``).
@@ -50,6 +52,7 @@ class EnvConfig:
     substeps: int = 4
     episode_steps: int = 600
     action_smoothing: float = 1.0
+    touch: str = "binary"
     tactile_threshold: float = 0.01
     reset_joint_noise: float = 0.2
     nconmax: int | None = None
@@ -64,6 +67,8 @@ class EnvConfig:
         get_robot(self.robot)
         if self.obs_mode not in OBS_MODES:
             raise ValueError(f"unknown obs_mode {self.obs_mode!r}; valid obs modes: {list(OBS_MODES)}")
+        if self.touch not in TOUCH_MODES:
+            raise ValueError(f"unknown touch {self.touch!r}; valid touch modes: {list(TOUCH_MODES)}")
         object.__setattr__(self, "extra_groups", tuple(self.extra_groups))  # a list read back from YAML
         for group in self.extra_groups:
             if group not in OBS_GROUPS:

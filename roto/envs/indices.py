@@ -27,7 +27,7 @@ class SceneIndices:
     ctrl_hi: torch.Tensor
     ball_pos: Columns  # (n_ball, 3) qpos indices of each ball's centre
     ball_vel: Columns  # (n_ball, 3) qvel indices of each ball's linear velocity
-    tactile_force: Columns  # (n_links,) sensordata index of each link's normal force
+    tactile_force: Columns  # binary touch: (n_links,) each link's strongest normal force; force: (n_links, 3) net force
     ball_force: Columns  # (n_ball,) sensordata index of each ball-hand normal force
     self_contact: Columns  # (2,) sensordata indices of the hand's self-contact (found, distance m)
     default_qpos: torch.Tensor  # (1, nq), the balls' quaternions at identity
@@ -38,7 +38,9 @@ class SceneIndices:
     coupled_hi: torch.Tensor
 
     @classmethod
-    def from_layout(cls, layout: SceneLayout, robot: RobotSpec, model: Any, device: torch.device) -> SceneIndices:
+    def from_layout(
+        cls, layout: SceneLayout, robot: RobotSpec, model: Any, device: torch.device, touch: str = "binary"
+    ) -> SceneIndices:
         def t(array: Any, dtype: torch.dtype = torch.int64) -> torch.Tensor:
             return torch.as_tensor(np.asarray(array), dtype=dtype, device=device)
 
@@ -65,7 +67,9 @@ class SceneIndices:
             ctrl_hi=t(layout.ctrl_hi, f64),
             ball_pos=c(layout.ball_qpos[:, None] + np.arange(3)),
             ball_vel=c(layout.ball_qvel[:, None] + np.arange(3)),
-            tactile_force=c(layout.tactile_sensor + 1),
+            tactile_force=c(
+                layout.tactile_sensor + 1 if touch == "binary" else layout.tactile_sensor[:, None] + 1 + np.arange(3)
+            ),
             ball_force=c(layout.ball_contact_sensor + 1),
             self_contact=c([layout.self_contact_sensor, layout.self_contact_sensor + 1]),
             default_qpos=t(default, f64)[None],

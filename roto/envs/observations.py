@@ -14,6 +14,14 @@ OBS_MODES: dict[str, tuple[str, ...]] = {
 }
 """Observation mode -> groups, in the order they are concatenated."""
 
+TOUCH_MODES: tuple[str, ...] = ("binary", "force")
+"""What the tactile group holds per tactile link: ``binary`` a touch bit (the benchmark's signal),
+``force`` the magnitude of the link's net contact force on a log scale (``touch_force``)."""
+
+FORCE_SCALE = 0.1
+"""F0 (N) of the ``force`` touch signal log(1 + |F| / F0): a 30 g ball resting on a hand (0.29 N)
+reads about 1.4, a 10 N impact about 4.6."""
+
 JOINT_VELOCITY_SCALE = 1.0 / 3.0
 """Joint velocities (rad/s) are multiplied by this in the proprio group (roto divides by 3)."""
 
@@ -28,6 +36,18 @@ def tactile_bits(contact_force: torch.Tensor, threshold: float) -> torch.Tensor:
         (B, n_links) float32 in {0, 1}.
     """
     return (contact_force > threshold).to(torch.float32)
+
+
+def touch_force(net_force: torch.Tensor, scale: float = FORCE_SCALE) -> torch.Tensor:
+    """Force touch per link: log(1 + |F| / F0) of the link's net contact force F.
+
+    Args:
+        net_force: (B, n_links, 3) net force of all the link's contacts, N (zero without contact).
+
+    Returns:
+        (B, n_links) float32, 0 without contact.
+    """
+    return torch.log1p(torch.linalg.vector_norm(net_force, dim=-1) / scale).to(torch.float32)
 
 
 def proprio_parts(qpos, qvel, lo, hi, target, actuated_qpos, velocity_scale: float = JOINT_VELOCITY_SCALE):

@@ -22,7 +22,15 @@ from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
 from roto.envs.indices import SceneIndices
-from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, privileged_frame, proprio_frame, tactile_bits
+from roto.envs.observations import (
+    OBS_GROUPS,
+    OBS_MODES,
+    FrameStack,
+    privileged_frame,
+    proprio_frame,
+    tactile_bits,
+    touch_force,
+)
 from roto.envs.start_pool import StartPool, draw_valid_starts
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
@@ -54,7 +62,7 @@ class Selected(NamedTuple):
     ball_pos: torch.Tensor  # (n, n_ball, 3) ball centres
     ball_vel: torch.Tensor  # (n, n_ball, 3) ball linear velocities
     ball_force: torch.Tensor  # (n, substeps, n_ball) ball-hand normal force of every substep
-    tactile_force: torch.Tensor  # (n, n_links) each tactile link's normal force, last substep
+    tactile_force: torch.Tensor  # last substep: (n, n_links) normal force, or (n, n_links, 3) net force (force touch)
 
 
 def _is_view_of(tensor: torch.Tensor, bases: tuple[torch.Tensor, ...]) -> bool:
@@ -85,7 +93,7 @@ class RotoEnv:
         wanted = set(OBS_MODES[config.obs_mode]) | set(config.extra_groups)
         self.groups = tuple(group for group in OBS_GROUPS if group in wanted)
         self.balls = self.task.balls(self.robot)
-        self.model, self.layout = build_scene(self.robot, self.balls)
+        self.model, self.layout = build_scene(self.robot, self.balls, config.touch)
         nconmax, njmax = warp_capacity(config.robot, config.task)
         self.backend = make_backend(
             config.backend,
@@ -99,7 +107,7 @@ class RotoEnv:
         )
         self._generator = torch.Generator(device=self.device)
         self._generator.manual_seed(config.seed)
-        self._idx = SceneIndices.from_layout(self.layout, self.robot, self.model, self.device)
+        self._idx = SceneIndices.from_layout(self.layout, self.robot, self.model, self.device, config.touch)
         self.num_actions = self.robot.num_actions
         self.task_state = self.task.init_state(self.robot, self.num_envs, self.device)
         self._stack = FrameStack(config.frame_stack)
@@ -375,11 +383,14 @@ class RotoEnv:
         last_action: torch.Tensor,
     ) -> dict[str, torch.Tensor]:
         """One observation frame per group from (n, ·) state selections; NaN and inf read as 0 (a
-        diverged world's last frame), the tactile bits are finite by construction."""
+        diverged world's last frame); the tactile bits are finite by construction."""
         idx = self._idx
         groups: dict[str, torch.Tensor] = {}
         if "tactile" in self.groups:
-            groups["tactile"] = tactile_bits(selected.tactile_force, self.config.tactile_threshold)
+            if self.config.touch == "force":
+                groups["tactile"] = touch_force(selected.tactile_force).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0)
+            else:
+                groups["tactile"] = tactile_bits(selected.tactile_force, self.config.tactile_threshold)
         groups["proprio"] = proprio_frame(
             selected.obs_qpos,
             selected.obs_qvel,

@@ -73,13 +73,20 @@ def build_model(sizes: Mapping[str, int], num_actions: int, agent: AgentConfig, 
 
 
 def build_learner(
-    model: ActorCritic, sizes: Mapping[str, int], num_actions: int, num_envs: int, agent: AgentConfig, seed: int
+    model: ActorCritic,
+    sizes: Mapping[str, int],
+    num_actions: int,
+    num_envs: int,
+    agent: AgentConfig,
+    seed: int,
+    touch: str = "binary",
 ) -> PPO:
-    """PPO with its rollout buffer (every group in ``sizes``), generator and auxiliary losses."""
+    """PPO with its rollout buffer (every group in ``sizes``), generator and auxiliary losses
+    (``touch``: the env's touch signal, for a reconstruction of the tactile group)."""
     device = next(model.parameters()).device
     buffer = RolloutBuffer(agent.ppo.rollouts, num_envs, sizes, num_actions, device)
     generator = torch.Generator(device=device).manual_seed(seed)
-    aux = build_aux_losses(agent.ssl, model, sizes, num_actions, agent.ppo.rollouts * num_envs)
+    aux = build_aux_losses(agent.ssl, model, sizes, num_actions, agent.ppo.rollouts * num_envs, touch)
     return PPO(model, agent.ppo, buffer, generator, aux)
 
 

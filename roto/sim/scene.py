@@ -3,8 +3,9 @@
 The model holds, besides the hand, one free-floating sphere per ball and two kinds of
 ``contact`` sensors (MuJoCo 4's exact per-body contact sensors):
 
-* one per tactile link: ``body1 = link``, any partner, data ``found force`` reduced to the
-  strongest contact, so the first force component is that contact's normal force;
+* one per tactile link: ``body1 = link``, any partner, data ``found force``; for binary touch
+  reduced to the strongest contact, so the first force component is that contact's normal force;
+  for force touch reduced to the net force of all the link's contacts (global frame);
 * one per ball: ``body1 = ball``, ``subtree2 = hand root`` (hand contact only, not ball-ball);
 * one for the hand's self-contacts: ``subtree1 = subtree2 = hand root``, data ``found dist``
   reduced to the deepest contact, which the env uses to keep interpenetrating poses out of
@@ -25,7 +26,7 @@ PHYSICS_DT = 1.0 / 240.0
 """Physics timestep (s), docs/spec.md §1."""
 
 _FOUND, _FORCE, _DIST = 1, 2, 8
-_REDUCE_MINDIST, _REDUCE_MAXFORCE = 1, 2
+_REDUCE_MINDIST, _REDUCE_MAXFORCE, _REDUCE_NETFORCE = 1, 2, 3
 CONTACT_SENSOR_DIM = 4
 """Values per contact sensor: (number of contacts found, force in the contact frame (3,))."""
 
@@ -64,7 +65,9 @@ class SceneLayout:
     hand_qpos: np.ndarray  # [n_hand_q] qpos addresses of every hand joint
 
 
-def _add_contact_sensor(spec: mujoco.MjSpec, name: str, body: str, subtree2: str | None = None) -> None:
+def _add_contact_sensor(
+    spec: mujoco.MjSpec, name: str, body: str, subtree2: str | None = None, reduce: int = _REDUCE_MAXFORCE
+) -> None:
     sensor = spec.add_sensor()
     sensor.name = name
     sensor.type = mujoco.mjtSensor.mjSENS_CONTACT
@@ -73,7 +76,7 @@ def _add_contact_sensor(spec: mujoco.MjSpec, name: str, body: str, subtree2: str
     if subtree2 is not None:
         sensor.reftype = mujoco.mjtObj.mjOBJ_XBODY
         sensor.refname = subtree2
-    sensor.intprm = np.array([_FOUND | _FORCE, _REDUCE_MAXFORCE, 1] + [0] * (len(sensor.intprm) - 3))
+    sensor.intprm = np.array([_FOUND | _FORCE, reduce, 1] + [0] * (len(sensor.intprm) - 3))
 
 
 def _add_self_contact_sensor(spec: mujoco.MjSpec, root: str) -> None:
@@ -85,8 +88,9 @@ def _add_self_contact_sensor(spec: mujoco.MjSpec, root: str) -> None:
     sensor.intprm = np.array([_FOUND | _DIST, _REDUCE_MINDIST, 1] + [0] * (len(sensor.intprm) - 3))
 
 
-def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...]) -> mujoco.MjSpec:
-    """The hand (posed in the task frame) plus the balls and roto's sensors, as an MjSpec."""
+def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...], touch: str = "binary") -> mujoco.MjSpec:
+    """The hand (posed in the task frame) plus the balls and roto's sensors, as an MjSpec; ``touch``
+    (``binary`` or ``force``) chooses what the tactile links' sensors reduce their contacts to."""
     spec = build_hand(robot)
     spec.modelname = f"roto_{robot.name}_{len(balls)}balls"
     spec.option.timestep = PHYSICS_DT
@@ -106,8 +110,9 @@ def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...]) -> mujoco.Mj
             condim=3,
             rgba=list(ball.rgba),
         )
+    reduce = {"binary": _REDUCE_MAXFORCE, "force": _REDUCE_NETFORCE}[touch]
     for link in robot.tactile_links:
-        _add_contact_sensor(spec, f"touch_{link}", link)
+        _add_contact_sensor(spec, f"touch_{link}", link, reduce=reduce)
     for ball in balls:
         _add_contact_sensor(spec, f"hand_contact_{ball.name}", ball.name, subtree2=robot.root_body)
     _add_self_contact_sensor(spec, robot.root_body)
@@ -154,7 +159,9 @@ def scene_layout(model: mujoco.MjModel, robot: RobotSpec, balls: tuple[BallSpec,
     )
 
 
-def build_scene(robot: RobotSpec, balls: tuple[BallSpec, ...]) -> tuple[mujoco.MjModel, SceneLayout]:
+def build_scene(
+    robot: RobotSpec, balls: tuple[BallSpec, ...], touch: str = "binary"
+) -> tuple[mujoco.MjModel, SceneLayout]:
     """Compile the scene and index it."""
-    model = build_scene_spec(robot, balls).compile()
+    model = build_scene_spec(robot, balls, touch).compile()
     return model, scene_layout(model, robot, balls)

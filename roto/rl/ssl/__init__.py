@@ -13,7 +13,12 @@ from roto.rl.ssl.reconstruction import Reconstruction
 
 
 def build_aux_losses(
-    config: SSLConfig, model: ActorCritic, sizes: Mapping[str, int], num_actions: int, samples_per_rollout: int
+    config: SSLConfig,
+    model: ActorCritic,
+    sizes: Mapping[str, int],
+    num_actions: int,
+    samples_per_rollout: int,
+    touch: str = "binary",
 ) -> list[AuxLoss]:
     """The enabled losses of ``config``, each with its heads on the model's device and its own Adam.
 
@@ -23,10 +28,11 @@ def build_aux_losses(
         sizes: {group: stacked size} of every group the env returns.
         num_actions: n.
         samples_per_rollout: rollouts x num_envs (the memory's default capacity).
+        touch: the env's touch signal (what a reconstruction of the tactile group decodes).
     """
     builders = {
-        "tactile_reconstruction": lambda name, c: Reconstruction(name, c, model, sizes),
-        "full_reconstruction": lambda name, c: Reconstruction(name, c, model, sizes),
+        "tactile_reconstruction": lambda name, c: Reconstruction(name, c, model, sizes, touch),
+        "full_reconstruction": lambda name, c: Reconstruction(name, c, model, sizes, touch),
         "forward_dynamics": lambda name, c: ForwardDynamics(name, c, model, num_actions),
         "forward_dynamics_memory": lambda name, c: ForwardDynamicsMemory(
             name, c, model, num_actions, samples_per_rollout

@@ -44,13 +44,23 @@ class Reconstruction:
         config: weight, lr, decoder sizes, target groups.
         model: the actor-critic whose encoder it trains.
         sizes: {group: stacked size} of every group the env returns.
+        touch: the env's touch signal; ``binary`` bits are decoded with a weighted BCE, ``force``
+            values (log-scaled forces) with an MSE.
     """
 
-    def __init__(self, name: str, config: ReconstructionConfig, model: ActorCritic, sizes: Mapping[str, int]) -> None:
+    def __init__(
+        self,
+        name: str,
+        config: ReconstructionConfig,
+        model: ActorCritic,
+        sizes: Mapping[str, int],
+        touch: str = "binary",
+    ) -> None:
         missing = [g for g in config.targets if g not in sizes]
         if missing:
             raise ValueError(f"ssl.{name}.targets: groups {missing} are not provided; available: {list(sizes)}")
         self.name, self.config = name, config
+        self.binary_tactile = touch == "binary"
         self.widths = [sizes[g] for g in config.targets]
         hidden = config.decoder[-1] if config.decoder else model.latent_width
         self.heads = nn.Sequential(mlp([model.latent_width, *config.decoder]), nn.Linear(hidden, sum(self.widths)))
@@ -64,12 +74,12 @@ class Reconstruction:
     def loss(
         self, model: ActorCritic, batch: dict, latent: torch.Tensor, aux_batch: Any
     ) -> tuple[torch.Tensor, dict[str, torch.Tensor]]:
-        """Sum over targets of BCE (tactile) or MSE (others) of the decoded ``latent`` (N, W)."""
+        """Sum over targets of BCE (binary tactile) or MSE (others) of the decoded ``latent`` (N, W)."""
         predictions = self.heads(latent).split(self.widths, dim=-1)
         terms = {}
         for group, prediction in zip(self.config.targets, predictions, strict=True):
             target = batch["obs"][group].to(prediction.dtype)
-            if group == "tactile":
+            if group == "tactile" and self.binary_tactile:
                 terms[group] = rare_bit_bce(prediction, target)
             else:
                 terms[group] = F.mse_loss(prediction, target)

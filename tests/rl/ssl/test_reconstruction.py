@@ -54,3 +54,14 @@ def test_reconstruction_shapes_and_its_optimizer_holds_the_encoder():
 def test_a_target_group_the_env_does_not_provide_is_an_error():
     with pytest.raises(ValueError, match=r"ssl.tactile_reconstruction.targets.*\['privileged'\]"):
         Reconstruction("tactile_reconstruction", ReconstructionConfig(targets=("privileged",)), small_model(), SIZES)
+
+
+def test_force_touch_is_decoded_with_mse_not_bce():
+    model = small_model()
+    loss_fn = Reconstruction("tactile_reconstruction", ReconstructionConfig(), model, SIZES, touch="force")
+    obs = {"tactile": torch.tensor([[0.0, 1.4, 4.6], [0.0, 0.0, 2.0]]), "proprio": torch.randn(2, 2)}
+    latent = model.encode(obs)
+    loss, metrics = loss_fn.loss(model, {"obs": obs}, latent, None)
+    expected = (loss_fn.heads(latent) - obs["tactile"]).square().mean()
+    assert loss.item() == pytest.approx(expected.item())
+    assert metrics["tactile"].item() == pytest.approx(expected.item())
