@@ -158,7 +158,9 @@ def _cmd_play(args: argparse.Namespace) -> int:
 def _cmd_render(args: argparse.Namespace) -> int:
     from roto.eval.video import render_scene
 
-    path = render_scene(args.task, args.robot, args.out, settle_steps=args.settle_steps, seed=args.seed)
+    path = render_scene(
+        args.task, args.robot, args.out, settle_steps=args.settle_steps, seed=args.seed, touch=args.touch
+    )
     print(json.dumps({"task": args.task, "robot": args.robot, "image": str(path)}))
     return 0
 
@@ -240,6 +242,7 @@ def _add_render_parser(sub: argparse._SubParsersAction) -> None:
     p_render.add_argument("--task", default="bounce")
     p_render.add_argument("--robot", default="shadow")
     p_render.add_argument("--out", default="scene.png")
+    _add_touch_arg(p_render)
     p_render.add_argument("--settle_steps", "--settle-steps", dest="settle_steps", type=int, default=60)
     p_render.add_argument("--seed", type=int, default=0)
     p_render.set_defaults(func=_cmd_render)

@@ -1,6 +1,7 @@
 """Render episodes of a policy offscreen into an mp4 (no display needed).
 
-Tactile links are drawn in a contact colour while their touch bit is on.
+Tactile links are drawn in a contact colour while their touch bit is on; with force touch, in a
+colour running from cyan (a light touch) to red (10 N or more) with the link's force.
 """
 
 from __future__ import annotations
@@ -11,12 +12,17 @@ import mujoco
 import numpy as np
 import torch
 
+from roto.envs.observations import FORCE_SCALE, touch_force
 from roto.envs.roto_env import RotoEnv
 from roto.rl.networks import ActorCritic
 from roto.rl.settings import TrainSettings
 
 TOUCH_RGBA = np.array([0.0, 0.85, 1.0, 1.0], dtype=np.float32)
-"""Colour of a tactile link while its bit is on (cyan)."""
+"""Colour of a tactile link while its bit is on (cyan), and of the lightest force touch."""
+HARD_TOUCH_RGBA = np.array([1.0, 0.15, 0.05, 1.0], dtype=np.float32)
+"""Colour of a tactile link pressed with ``HARD_TOUCH_VALUE`` or more (red), with force touch."""
+HARD_TOUCH_VALUE = float(np.log1p(10.0 / FORCE_SCALE))
+"""The force touch value (10 N) drawn fully in ``HARD_TOUCH_RGBA``."""
 FPS = 60
 """One frame per control step (60 Hz), so the video plays in real time."""
 
@@ -30,8 +36,14 @@ def _camera() -> mujoco.MjvCamera:
     return camera
 
 
+def force_touch_rgba(values: np.ndarray) -> np.ndarray:
+    """Colours (n, 4) of force touch ``values`` (n,) > 0: from ``TOUCH_RGBA`` to ``HARD_TOUCH_RGBA``."""
+    share = np.clip(np.asarray(values, dtype=np.float32) / HARD_TOUCH_VALUE, 0.0, 1.0)[:, None]
+    return (1.0 - share) * TOUCH_RGBA + share * HARD_TOUCH_RGBA
+
+
 class TactileFrameRenderer:
-    """Renders world 0 of an env, colouring the geoms of tactile links whose bit is on."""
+    """Renders world 0 of an env, colouring the geoms of its touching tactile links."""
 
     def __init__(self, env: RotoEnv, width: int = 640, height: int = 480) -> None:
         self.env = env
@@ -44,18 +56,27 @@ class TactileFrameRenderer:
         self._link_geoms = [np.flatnonzero(self.model.geom_bodyid == b) for b in body_ids]
 
     def render(self) -> np.ndarray:
-        """(height, width, 3) uint8 of world 0, touching links coloured (same threshold as the env)."""
+        """(height, width, 3) uint8 of world 0, touching links coloured (as the env reads touch)."""
         mujoco.mj_setState(
             self.model, self.data, self.env.backend.physics_state()[0], mujoco.mjtState.mjSTATE_FULLPHYSICS
         )
         mujoco.mj_forward(self.model, self.data)
-        force = self.data.sensordata[self.env.layout.tactile_sensor + 1]
         self.model.geom_rgba[:] = self._base_rgba
-        for f, geoms in zip(force.tolist(), self._link_geoms, strict=True):
-            if f > self.env.config.tactile_threshold:
-                self.model.geom_rgba[geoms] = TOUCH_RGBA
+        for geoms, rgba in zip(self._link_geoms, self._touch_colours(), strict=True):
+            if rgba is not None:
+                self.model.geom_rgba[geoms] = rgba
         self.renderer.update_scene(self.data, camera=self.camera)
         return self.renderer.render().copy()
+
+    def _touch_colours(self) -> list[np.ndarray | None]:
+        """Per tactile link, its colour if it is touching (after ``mj_forward``), else None."""
+        sensors = self.data.sensordata
+        if self.env.config.touch == "force":
+            net = sensors[self.env.layout.tactile_sensor[:, None] + 1 + np.arange(3)]
+            values = touch_force(torch.from_numpy(net)[None])[0].numpy()
+            return [rgba if value > 0 else None for value, rgba in zip(values, force_touch_rgba(values), strict=True)]
+        force = sensors[self.env.layout.tactile_sensor + 1]
+        return [TOUCH_RGBA if f > self.env.config.tactile_threshold else None for f in force.tolist()]
 
     def close(self) -> None:
         """Free the GL context and restore the colours."""
@@ -111,11 +132,13 @@ def render_scene(
     seed: int = 0,
     width: int = 640,
     height: int = 480,
+    touch: str = "binary",
 ) -> pathlib.Path:
     """A PNG of ``robot`` in ``task``'s scene after ``settle_steps`` steps holding the default pose.
 
     The hand holds its default (cupped) pose with no reset noise, so the picture shows where the
-    objects come to rest; touching links are drawn in the contact colour.
+    objects come to rest; touching links are drawn in the contact colour (with ``touch="force"``,
+    coloured by their force).
     """
     import imageio.v2 as imageio
 
@@ -123,7 +146,7 @@ def render_scene(
 
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    env = RotoEnv(EnvConfig(task=task, robot=robot, num_envs=1, seed=seed, reset_joint_noise=0.0))
+    env = RotoEnv(EnvConfig(task=task, robot=robot, num_envs=1, seed=seed, reset_joint_noise=0.0, touch=touch))
     env.reset(seed=seed)
     hold = env.hold_action()
     for _ in range(settle_steps):

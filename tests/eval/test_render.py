@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from roto.cli import main
-from roto.eval.video import TOUCH_RGBA
+from roto.eval.video import HARD_TOUCH_RGBA, HARD_TOUCH_VALUE, TOUCH_RGBA, force_touch_rgba
 
 
 def cyan_pixels(image):
@@ -33,3 +33,21 @@ def test_render_unknown_robot_is_a_clear_error(tmp_path, capsys):
     assert main(["render", "--robot", "leap", "--out", str(tmp_path / "x.png")]) == 2
     assert "unknown robot 'leap'" in capsys.readouterr().err
     assert not (tmp_path / "x.png").exists()
+
+
+def test_force_touch_colours_run_from_cyan_to_red():
+    rgba = force_touch_rgba(np.array([1e-6, HARD_TOUCH_VALUE / 2, HARD_TOUCH_VALUE, 50.0]))
+    np.testing.assert_allclose(rgba[0], TOUCH_RGBA, atol=1e-5)
+    np.testing.assert_allclose(rgba[1], (TOUCH_RGBA + HARD_TOUCH_RGBA) / 2, atol=1e-6)
+    np.testing.assert_allclose(rgba[2], HARD_TOUCH_RGBA)
+    np.testing.assert_allclose(rgba[3], HARD_TOUCH_RGBA)  # capped
+
+
+def test_render_with_force_touch_colours_links_by_their_force(tmp_path):
+    paths = {touch: tmp_path / f"{touch}.png" for touch in ("binary", "force")}
+    for touch, path in paths.items():
+        assert main(["render", "--task", "baoding", "--touch", touch, "--out", str(path), "--settle_steps", "30"]) == 0
+    binary, force = (imageio.imread(path) for path in paths.values())
+    # the palm carries both balls: cyan with binary touch, pressed towards red with force touch
+    assert cyan_pixels(binary) > 200
+    assert cyan_pixels(force) < cyan_pixels(binary) / 2
