@@ -35,13 +35,18 @@ def _add_touch_arg(parser: argparse.ArgumentParser) -> None:
 def _cmd_list(args: argparse.Namespace) -> int:
     import roto
     from roto.registry import gym_id
+    from roto.sim.scene import hand_taxels
 
-    print(f"{'task':<9} {'robot':<12} {'gymnasium id':<30} {'actions':>7} {'frame (blind)':>13} {'stacked':>8}")
+    header = f"{'task':<9} {'robot':<12} {'gymnasium id':<30} {'actions':>7} {'frame (blind)':>13} {'stacked':>8}"
+    print(f"{header} {'taxels':>6} {'frame (taxels)':>14}")
+    taxels = {}
     for task, robot in roto.list_envs():
         env = roto.make(task, robot=robot, num_envs=1)
         frame = sum(env.frame_sizes.values())
         stacked = frame * env.config.frame_stack
-        print(f"{task:<9} {robot:<12} {gym_id(task, robot):<30} {env.num_actions:>7} {frame:>13} {stacked:>8}")
+        taxels[robot] = taxels.get(robot) or len(hand_taxels(env.robot))
+        row = f"{task:<9} {robot:<12} {gym_id(task, robot):<30} {env.num_actions:>7} {frame:>13} {stacked:>8}"
+        print(f"{row} {taxels[robot]:>6} {frame + taxels[robot]:>14}")
         env.close()
     return 0
 

@@ -8,6 +8,7 @@ def test_list_prints_every_pair_with_sizes(capsys):
     out = capsys.readouterr().out
     assert "roto/Bounce-Shadow-v0" in out and "roto/Baoding-Shadow-v0" in out
     assert "97" in out and "388" in out
+    assert "frame (taxels)" in out and "143" in out  # Shadow: 97 + 46 taxels
 
 
 def test_bench_json_has_the_contract_fields(capsys):

@@ -30,9 +30,10 @@ class EnvConfig:
         substeps: physics steps per control step (1/240 s each).
         episode_steps: control steps per episode (10 s at 60 Hz).
         action_smoothing: alpha of the exponential smoothing of joint targets (1 = none).
-        touch: what the tactile group holds per link: ``binary`` (a touch bit, the benchmark's
-            signal) or ``force`` (log(1 + |F| / 0.1 N) of the link's net contact force).
-        tactile_threshold: normal force (N) above which a link counts as touched (binary touch).
+        touch: what the tactile group holds: ``binary`` (a touch bit per link, the benchmark's
+            signal), ``force`` (log(1 + |F| / 0.1 N) of each link's net contact force) or
+            ``taxels`` (the links' bits, then a bit per taxel of the fingertip pads and the palm).
+        tactile_threshold: normal force (N) above which a link or a taxel counts as touched.
         reset_joint_noise: half-width (rad) of the uniform noise added to the default pose at reset.
         nconmax: contacts per world the ``warp`` backend allocates (None: roto's measured figure for
             this robot and task, ``roto.envs.capacity``).

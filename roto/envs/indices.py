@@ -27,8 +27,9 @@ class SceneIndices:
     ctrl_hi: torch.Tensor
     ball_pos: Columns  # (n_ball, 3) qpos indices of each ball's centre
     ball_vel: Columns  # (n_ball, 3) qvel indices of each ball's linear velocity
-    tactile_force: Columns  # binary touch: (n_links,) each link's strongest normal force; force: (n_links, 3) net force
+    tactile_force: Columns  # (n_links,) each link's strongest normal force; force touch: (n_links, 3) net force
     ball_force: Columns  # (n_ball,) sensordata index of each ball-hand normal force
+    taxels: Columns  # (n_taxels,) sensordata index of each taxel's normal force (empty without taxels)
     self_contact: Columns  # (2,) sensordata indices of the hand's self-contact (found, distance m)
     default_qpos: torch.Tensor  # (1, nq), the balls' quaternions at identity
     coupled_driven: Columns
@@ -68,9 +69,10 @@ class SceneIndices:
             ball_pos=c(layout.ball_qpos[:, None] + np.arange(3)),
             ball_vel=c(layout.ball_qvel[:, None] + np.arange(3)),
             tactile_force=c(
-                layout.tactile_sensor + 1 if touch == "binary" else layout.tactile_sensor[:, None] + 1 + np.arange(3)
+                layout.tactile_sensor[:, None] + 1 + np.arange(3) if touch == "force" else layout.tactile_sensor + 1
             ),
             ball_force=c(layout.ball_contact_sensor + 1),
+            taxels=c(layout.taxel_sensor),
             self_contact=c([layout.self_contact_sensor, layout.self_contact_sensor + 1]),
             default_qpos=t(default, f64)[None],
             coupled_driven=c(driven),

@@ -14,9 +14,10 @@ OBS_MODES: dict[str, tuple[str, ...]] = {
 }
 """Observation mode -> groups, in the order they are concatenated."""
 
-TOUCH_MODES: tuple[str, ...] = ("binary", "force")
-"""What the tactile group holds per tactile link: ``binary`` a touch bit (the benchmark's signal),
-``force`` the magnitude of the link's net contact force on a log scale (``touch_force``)."""
+TOUCH_MODES: tuple[str, ...] = ("binary", "force", "taxels")
+"""What the tactile group holds: ``binary`` a touch bit per tactile link (the benchmark's signal),
+``force`` the magnitude of each link's net contact force on a log scale (``touch_force``),
+``taxels`` the links' bits followed by one bit per taxel of the fingertip pads and the palm."""
 
 FORCE_SCALE = 0.1
 """F0 (N) of the ``force`` touch signal log(1 + |F| / F0): a 30 g ball resting on a hand (0.29 N)

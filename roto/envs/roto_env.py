@@ -63,6 +63,7 @@ class Selected(NamedTuple):
     ball_vel: torch.Tensor  # (n, n_ball, 3) ball linear velocities
     ball_force: torch.Tensor  # (n, substeps, n_ball) ball-hand normal force of every substep
     tactile_force: torch.Tensor  # last substep: (n, n_links) normal force, or (n, n_links, 3) net force (force touch)
+    taxel_force: torch.Tensor | None = None  # last substep: (n, n_taxels) each taxel's normal force (taxel touch)
 
 
 def _is_view_of(tensor: torch.Tensor, bases: tuple[torch.Tensor, ...]) -> bool:
@@ -131,7 +132,7 @@ class RotoEnv:
             (idx.ball_vel, 1),
             (idx.ball_force, 2),
             (idx.tactile_force, 3),
-        )
+        ) + (((idx.taxels, 3),) if config.touch == "taxels" else ())
         self._selected_cache: tuple | None = None
         # reading the device is free on the CPU and waits for a GPU. A sync-free step reads nothing:
         # resets run masked every step, and the pool of starts and the action check are read every
@@ -284,7 +285,7 @@ class RotoEnv:
     def _frame_sizes(self) -> dict[str, int]:
         n_obs, n_act = len(self.robot.observed_joints), self.num_actions
         sizes = {
-            "tactile": len(self.robot.tactile_links),
+            "tactile": len(self.robot.tactile_links) + len(self.layout.taxel_sensor),
             "proprio": 2 * n_obs + 2 * n_act,
             "privileged": 6 * len(self.balls),
         }
@@ -366,7 +367,7 @@ class RotoEnv:
         selected = self._select(qpos, qvel, sensors)
         if qpos is sim.qpos and qvel is sim.qvel and sensors is sim.sensordata:  # no conversion copied them
             bases = (qpos, qvel, sensors)
-            copies = tuple(i for i, value in enumerate(selected) if not _is_view_of(value, bases))
+            copies = tuple(i for i in range(len(self._selections)) if not _is_view_of(selected[i], bases))
             self._selected_cache = (sim.qpos, sim.qvel, sim.sensordata, selected, copies)
         return selected
 
@@ -391,6 +392,9 @@ class RotoEnv:
                 groups["tactile"] = touch_force(selected.tactile_force).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0)
             else:
                 groups["tactile"] = tactile_bits(selected.tactile_force, self.config.tactile_threshold)
+            if self.config.touch == "taxels":
+                taxels = tactile_bits(selected.taxel_force, self.config.tactile_threshold)
+                groups["tactile"] = torch.cat([groups["tactile"], taxels], dim=-1)
         groups["proprio"] = proprio_frame(
             selected.obs_qpos,
             selected.obs_qvel,

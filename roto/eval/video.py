@@ -1,7 +1,8 @@
 """Render episodes of a policy offscreen into an mp4 (no display needed).
 
 Tactile links are drawn in a contact colour while their touch bit is on; with force touch, in a
-colour running from cyan (a light touch) to red (10 N or more) with the link's force.
+colour running from cyan (a light touch) to red (10 N or more) with the link's force; with taxel
+touch, the pressed taxels are drawn as yellow boxes as well.
 """
 
 from __future__ import annotations
@@ -16,11 +17,14 @@ from roto.envs.observations import FORCE_SCALE, touch_force
 from roto.envs.roto_env import RotoEnv
 from roto.rl.networks import ActorCritic
 from roto.rl.settings import TrainSettings
+from roto.sim.scene import TAXEL_SITE_GROUP
 
 TOUCH_RGBA = np.array([0.0, 0.85, 1.0, 1.0], dtype=np.float32)
 """Colour of a tactile link while its bit is on (cyan), and of the lightest force touch."""
 HARD_TOUCH_RGBA = np.array([1.0, 0.15, 0.05, 1.0], dtype=np.float32)
 """Colour of a tactile link pressed with ``HARD_TOUCH_VALUE`` or more (red), with force touch."""
+TAXEL_RGBA = np.array([1.0, 0.85, 0.0, 1.0], dtype=np.float32)
+"""Colour of a pressed taxel (yellow); the others are not drawn."""
 HARD_TOUCH_VALUE = float(np.log1p(10.0 / FORCE_SCALE))
 """The force touch value (10 N) drawn fully in ``HARD_TOUCH_RGBA``."""
 FPS = 60
@@ -52,6 +56,17 @@ class TactileFrameRenderer:
         self.renderer = mujoco.Renderer(self.model, height=height, width=width)
         self.camera = _camera()
         self._base_rgba = self.model.geom_rgba.copy()
+        self._base_site_rgba = self.model.site_rgba.copy()
+        self._taxel_sites = np.array(
+            [
+                self.model.sensor_objid[i]
+                for i in range(self.model.nsensor)
+                if self.model.sensor_type[i] == mujoco.mjtSensor.mjSENS_TOUCH
+            ],
+            dtype=np.int64,
+        )
+        self._option = mujoco.MjvOption()
+        self._option.sitegroup[TAXEL_SITE_GROUP] = 1
         body_ids = [self.model.body(link).id for link in env.robot.tactile_links]
         self._link_geoms = [np.flatnonzero(self.model.geom_bodyid == b) for b in body_ids]
 
@@ -65,7 +80,10 @@ class TactileFrameRenderer:
         for geoms, rgba in zip(self._link_geoms, self._touch_colours(), strict=True):
             if rgba is not None:
                 self.model.geom_rgba[geoms] = rgba
-        self.renderer.update_scene(self.data, camera=self.camera)
+        self.model.site_rgba[self._taxel_sites] = 0.0  # only pressed taxels are drawn
+        pressed = self.data.sensordata[self.env.layout.taxel_sensor] > self.env.config.tactile_threshold
+        self.model.site_rgba[self._taxel_sites[pressed]] = TAXEL_RGBA
+        self.renderer.update_scene(self.data, camera=self.camera, scene_option=self._option)
         return self.renderer.render().copy()
 
     def _touch_colours(self) -> list[np.ndarray | None]:
@@ -81,6 +99,7 @@ class TactileFrameRenderer:
     def close(self) -> None:
         """Free the GL context and restore the colours."""
         self.model.geom_rgba[:] = self._base_rgba
+        self.model.site_rgba[:] = self._base_site_rgba
         self.renderer.close()
 
 

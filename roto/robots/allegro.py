@@ -190,6 +190,7 @@ ALLEGRO = RobotSpec(
     palm_geom="palm_box",
     knuckle_bodies=("ff_base", "mf_base", "rf_base"),
     tip_bodies=("ff_tip", "mf_tip", "rf_tip"),
+    thumb_tip="th_tip",
     baoding_ball_radius=0.5 * 2.0 * 0.0254,
     baoding_targets=((0.0597, 0.0223, 0.0205), (0.0578, -0.0284, 0.0216)),  # calibrate_targets(ALLEGRO)
 )

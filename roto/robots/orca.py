@@ -109,6 +109,7 @@ ORCA = RobotSpec(
     palm_geom="right_palm_box0",
     knuckle_bodies=tuple(_j(f"{f}_mp") for f in _FINGERS),
     tip_bodies=tuple(_j(f"{f}_ip") for f in _FINGERS),
+    thumb_tip=_j("thumb_dp"),
     baoding_ball_radius=0.5 * 1.5 * 0.0254,
     baoding_targets=((0.0691, 0.035, -0.0199), (0.0777, -0.002, -0.0229)),  # calibrate_targets(ORCA)
     # The bounding boxes are fuller than the meshes: the palm box reaches the fingers' first links.

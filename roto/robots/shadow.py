@@ -85,6 +85,7 @@ SHADOW = RobotSpec(
     palm_geom=_j("C_palm0"),
     knuckle_bodies=tuple(_j(f"{f}knuckle") for f in ("ff", "mf", "rf", "lf")),
     tip_bodies=tuple(_j(f"{f}distal") for f in ("ff", "mf", "rf", "lf")),
+    thumb_tip=_j("thdistal"),
     baoding_ball_radius=0.5 * 1.5 * 0.0254,
     baoding_targets=((0.0243, 0.0073, 0.0028), (0.0577, -0.0079, -0.0066)),  # calibrate_targets(SHADOW)
 )

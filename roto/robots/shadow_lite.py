@@ -122,6 +122,7 @@ SHADOW_LITE = RobotSpec(
     palm_geom=_j("C_palm0"),
     knuckle_bodies=tuple(_j(f"{f}knuckle") for f in _FINGERS),
     tip_bodies=tuple(_j(f"{f}distal") for f in _FINGERS),
+    thumb_tip=_j("thdistal"),
     baoding_ball_radius=0.5 * 1.2 * 0.0254,
     baoding_targets=((0.0265, -0.0173, 0.0098), (0.0559, -0.0106, 0.0068)),  # calibrate_targets(SHADOW_LITE)
     excluded_contacts=tuple((_j("palm"), _j(b)) for b in ("ffknuckle", "mfknuckle", "rfknuckle", "thbase")),

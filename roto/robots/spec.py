@@ -38,6 +38,7 @@ class RobotSpec:
         palm_geom: the collision geom whose top face is the palm surface.
         knuckle_bodies: finger base bodies, index finger first and little (or last) finger last.
         tip_bodies: distal finger bodies, used to find the finger direction.
+        thumb_tip: the thumb's distal body (with ``tip_bodies`` and the palm: where taxels lie).
         baoding_ball_radius: Baoding ball radius for this hand (m).
         baoding_targets: T_a and T_b (task frame, m), calibrated where two balls really rest in
             the default pose (``roto.tasks.baoding.calibrate_targets``; a test re-checks them).
@@ -62,6 +63,7 @@ class RobotSpec:
     palm_geom: str
     knuckle_bodies: tuple[str, ...]
     tip_bodies: tuple[str, ...]
+    thumb_tip: str
     baoding_ball_radius: float
     baoding_targets: tuple[tuple[float, float, float], tuple[float, float, float]]
     coupled_joints: Mapping[str, tuple[str, float]] = field(default_factory=dict)

@@ -10,6 +10,9 @@ The model holds, besides the hand, one free-floating sphere per ball and two kin
 * one for the hand's self-contacts: ``subtree1 = subtree2 = hand root``, data ``found dist``
   reduced to the deepest contact, which the env uses to keep interpenetrating poses out of
   episode starts.
+
+With taxel touch, a ``touch`` sensor on each taxel box over the fingertip pads and the palm
+(``roto.sim.taxels``).
 """
 
 from __future__ import annotations
@@ -21,12 +24,15 @@ import numpy as np
 
 from roto.robots.mjspec_tools import build_hand
 from roto.robots.spec import RobotSpec
+from roto.sim.taxels import FINGERTIP_GRID, PALM_GRID, Taxel, pad_grid
 
 PHYSICS_DT = 1.0 / 240.0
 """Physics timestep (s), docs/spec.md §1."""
 
 _FOUND, _FORCE, _DIST = 1, 2, 8
 _REDUCE_MINDIST, _REDUCE_MAXFORCE, _REDUCE_NETFORCE = 1, 2, 3
+TAXEL_SITE_GROUP = 5
+"""Site group of the taxel boxes (not drawn by default)."""
 CONTACT_SENSOR_DIM = 4
 """Values per contact sensor: (number of contacts found, force in the contact frame (3,))."""
 
@@ -59,6 +65,7 @@ class SceneLayout:
     ball_qpos: np.ndarray  # [n_ball] qpos address of each ball's free joint (position xyz, quat wxyz)
     ball_qvel: np.ndarray  # [n_ball] dof address of each ball's free joint (linear xyz, angular xyz)
     tactile_sensor: np.ndarray  # [n_tactile] sensordata address of each link's contact sensor
+    taxel_sensor: np.ndarray  # [n_taxels] sensordata address of each taxel's touch sensor (none without taxels)
     self_contact_sensor: int  # sensordata address of the hand's self-contact sensor (found, dist)
     ball_contact_sensor: np.ndarray  # [n_ball] sensordata address of each ball-hand contact sensor
     default_qpos: np.ndarray  # [nq] hand at its default pose, balls at the origin (placed by the task)
@@ -90,7 +97,8 @@ def _add_self_contact_sensor(spec: mujoco.MjSpec, root: str) -> None:
 
 def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...], touch: str = "binary") -> mujoco.MjSpec:
     """The hand (posed in the task frame) plus the balls and roto's sensors, as an MjSpec; ``touch``
-    (``binary`` or ``force``) chooses what the tactile links' sensors reduce their contacts to."""
+    (``binary``, ``force`` or ``taxels``) chooses what the tactile links' sensors reduce their
+    contacts to, and whether the fingertips and the palm carry taxels."""
     spec = build_hand(robot)
     spec.modelname = f"roto_{robot.name}_{len(balls)}balls"
     spec.option.timestep = PHYSICS_DT
@@ -110,13 +118,47 @@ def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...], touch: str =
             condim=3,
             rgba=list(ball.rgba),
         )
-    reduce = {"binary": _REDUCE_MAXFORCE, "force": _REDUCE_NETFORCE}[touch]
+    reduce = _REDUCE_NETFORCE if touch == "force" else _REDUCE_MAXFORCE
     for link in robot.tactile_links:
         _add_contact_sensor(spec, f"touch_{link}", link, reduce=reduce)
     for ball in balls:
         _add_contact_sensor(spec, f"hand_contact_{ball.name}", ball.name, subtree2=robot.root_body)
     _add_self_contact_sensor(spec, robot.root_body)
+    if touch == "taxels":
+        for k, taxel in enumerate(hand_taxels(robot)):
+            _add_taxel(spec, f"taxel_{k}", taxel)
     return spec
+
+
+def hand_taxels(robot: RobotSpec) -> list[Taxel]:
+    """The hand's taxels, in observation order: each fingertip (``tip_bodies``, then the thumb's),
+    then the palm (``roto.sim.taxels``), laid out at the default pose in the task frame."""
+    spec = build_hand(robot)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    for joint, angle in robot.default_pose.items():
+        data.qpos[model.joint(joint).qposadr[0]] = angle
+    mujoco.mj_kinematics(model, data)
+    above_palm = np.array([0.0, 0.0, 0.05])  # task frame: palm centre at the origin, z up
+    taxels = []
+    for tip in (*robot.tip_bodies, robot.thumb_tip):
+        taxels += pad_grid(model, data, tip, above_palm - data.body(tip).xpos, FINGERTIP_GRID)
+    palm = model.body(model.geom(robot.palm_geom).bodyid[0]).name
+    return taxels + pad_grid(model, data, palm, np.array([0.0, 0.0, 1.0]), PALM_GRID)
+
+
+def _add_taxel(spec: mujoco.MjSpec, name: str, taxel: Taxel) -> None:
+    site = spec.body(taxel.body).add_site()
+    site.name = name
+    site.type = mujoco.mjtGeom.mjGEOM_BOX
+    site.pos = taxel.pos
+    site.size = taxel.half_size
+    site.group = TAXEL_SITE_GROUP
+    sensor = spec.add_sensor()
+    sensor.name = name
+    sensor.type = mujoco.mjtSensor.mjSENS_TOUCH
+    sensor.objtype = mujoco.mjtObj.mjOBJ_SITE
+    sensor.objname = name
 
 
 def scene_layout(model: mujoco.MjModel, robot: RobotSpec, balls: tuple[BallSpec, ...]) -> SceneLayout:
@@ -154,6 +196,10 @@ def scene_layout(model: mujoco.MjModel, robot: RobotSpec, balls: tuple[BallSpec,
         tactile_sensor=np.array([sensor_adr(f"touch_{link}") for link in robot.tactile_links], dtype=np.int64),
         ball_contact_sensor=np.array([sensor_adr(f"hand_contact_{b.name}") for b in balls], dtype=np.int64),
         self_contact_sensor=sensor_adr("hand_self_contact"),
+        taxel_sensor=np.array(
+            [model.sensor_adr[i] for i in range(model.nsensor) if model.sensor(i).name.startswith("taxel_")],
+            dtype=np.int64,
+        ),
         default_qpos=default_qpos,
         hand_qpos=model.jnt_qposadr[hand_joints].astype(np.int64),
     )

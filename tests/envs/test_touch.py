@@ -25,7 +25,7 @@ def test_touch_force_is_log_of_the_force_magnitude():
 
 
 def test_an_unknown_touch_mode_names_the_valid_ones():
-    with pytest.raises(ValueError, match=r"unknown touch 'taxel'; valid touch modes: \['binary', 'force'\]"):
+    with pytest.raises(ValueError, match=r"unknown touch 'taxel'; valid touch modes: \['binary', 'force', 'taxels'\]"):
         roto.make("bounce", touch="taxel")
 
 

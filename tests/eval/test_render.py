@@ -51,3 +51,18 @@ def test_render_with_force_touch_colours_links_by_their_force(tmp_path):
     # the palm carries both balls: cyan with binary touch, pressed towards red with force touch
     assert cyan_pixels(binary) > 200
     assert cyan_pixels(force) < cyan_pixels(binary) / 2
+
+
+def yellow_pixels(image):
+    r, g, b = (image[..., i].astype(np.int16) for i in range(3))
+    return int(((r - b > 60) & (g - b > 50) & (np.abs(r - g) < 60)).sum())
+
+
+def test_render_with_taxel_touch_draws_the_pressed_taxels(tmp_path):
+    counts = {}
+    for touch in ("binary", "taxels"):
+        out = tmp_path / f"{touch}.png"
+        args = ["render", "--robot", "allegro", "--touch", touch, "--out", str(out), "--settle_steps", "60"]
+        assert main(args) == 0
+        counts[touch] = yellow_pixels(imageio.imread(out))
+    assert counts["binary"] < 20 < counts["taxels"]

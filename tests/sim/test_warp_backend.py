@@ -168,6 +168,23 @@ def test_force_touch_reads_the_same_forces_on_both_backends(name):
         env.close()
 
 
+@pytest.mark.parametrize("name", ["allegro", "shadow"])
+def test_taxels_light_the_same_on_both_backends(name):
+    envs = [roto.make("baoding", robot=name, num_envs=1, backend=b, touch="taxels") for b in ("cpu", "warp")]
+    hold = envs[0].hold_action()
+    tactile = []
+    for env in envs:
+        env.reset()
+        tactile.append([env.step(hold)[0]["tactile"].clone() for _ in range(20)])
+    for step_cpu, step_warp in zip(*tactile, strict=True):
+        assert torch.equal(step_cpu, step_warp)
+    n_links = len(envs[0].robot.tactile_links)
+    frame = envs[0].frame_sizes["tactile"]
+    assert tactile[0][-1][0, -frame + n_links :].sum() > 0  # taxels under the balls are on
+    for env in envs:
+        env.close()
+
+
 def test_same_seed_is_bit_identical_on_warp_cpu():
     runs = []
     for _ in range(2):
