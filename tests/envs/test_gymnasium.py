@@ -75,3 +75,13 @@ def test_single_env_follows_the_batched_env_with_one_world(task, robot):
     assert episodes >= 1  # an episode's end and the reset after it were compared too
     single.close()
     batched.close()
+
+
+@pytest.mark.parametrize("touch", ["force", "taxels"])
+def test_touch_is_a_gymnasium_kwarg_and_sizes_the_tactile_space(touch):
+    env = gym.make(gym_id("baoding", "orca"), touch=touch)
+    check_env(env.unwrapped, skip_render_check=True)
+    inner = env.unwrapped.env
+    assert env.observation_space["tactile"].shape == (inner.frame_sizes["tactile"] * inner.config.frame_stack,)
+    assert inner.config.touch == touch
+    env.close()
