@@ -32,6 +32,7 @@ from roto.eval.evaluate import evaluate
 from roto.eval.plots import plot_variants, read_scalars
 from roto.rl.config import load_agent_config
 from roto.rl.evaluation import read_evaluations
+from roto.rl.overrides import apply_env_overrides, split_overrides
 from roto.rl.runner import CHECKPOINT_DIR, Trainer, TrainSettings, load_policy
 
 FD = "weight: 0.0021, lr: 1.5e-5, seq_length: 8, max_sequences: 292"
@@ -46,17 +47,20 @@ VARIANTS = {
         "forward_dynamics": [f"ssl.forward_dynamics={{{FD}}}"],
         "forward_dynamics_memory": [f"ssl.forward_dynamics_memory={{{FD}}}"],
         "privileged_critic": ["network.critic=[tactile, proprio, privileged]"],
+        "force_touch": ["env.touch=force"],
     },
     "baoding": {
         "config": "baoding",
         "base": [],
         "ppo": [],
         "forward_dynamics_memory": ["ssl.forward_dynamics_memory={weight: 0.025, lr: 2.5e-4, seq_length: 2}"],
+        "force_touch": ["env.touch=force"],
     },
 }
 """Per task: the base agent config (a packaged name), overrides every variant shares ("base": for
 Bounce a quarter of roto's entropy bonus, which keeps the action noise from drifting up within the
-budget, docs/results.md) and each variant's own overrides on top."""
+budget, docs/results.md) and each variant's own overrides on top; ``env.<key>=value`` ones change
+the env (``force_touch``: PPO on force touch instead of binary touch)."""
 
 METRIC = {"bounce": "bounces", "baoding": "rotations"}
 
@@ -73,9 +77,11 @@ def train_one(task: str, variant: str, seed: int, args: argparse.Namespace) -> p
     if (run_dir / CHECKPOINT_DIR / "latest.pt").is_file():
         trainer = Trainer.resume(run_dir, total_steps=args.steps)
     else:
+        env_changes, overrides = split_overrides([*VARIANTS[task]["base"], *VARIANTS[task][variant]])
         env = EnvConfig(task=task, robot=args.robot, obs_mode=args.obs, num_envs=args.num_envs, seed=seed,
                         threads=args.threads)  # fmt: skip
-        agent = load_agent_config(task, VARIANTS[task]["config"], [*VARIANTS[task]["base"], *VARIANTS[task][variant]])
+        env = apply_env_overrides(env, env_changes)
+        agent = load_agent_config(task, VARIANTS[task]["config"], overrides)
         trainer = Trainer(TrainSettings(env=env, total_steps=args.steps), agent, run_dir)
     if trainer.update < trainer.total_updates:
         print(f"{task}/{variant}/seed{seed}: training from update {trainer.update}", flush=True)
