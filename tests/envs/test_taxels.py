@@ -7,25 +7,11 @@ import pytest
 import torch
 
 import roto
-from roto.robots import ROBOTS, get_robot
-from roto.sim.scene import build_scene
+from roto.robots import ROBOTS
 from roto.sim.taxels import FINGERTIP_GRID, PALM_GRID
-from roto.tasks.bounce import BALL
+from tests.envs.scenes import ball_resting_on_hand
 
 THRESHOLD = 0.01  # N, the env's default tactile_threshold
-
-
-def settled_scene(robot_name: str, seconds: float = 3.0):
-    """A Bounce ball let down onto the hand held at its default pose, left to come to rest."""
-    model, layout = build_scene(get_robot(robot_name), (BALL,), touch="taxels")
-    data = mujoco.MjData(model)
-    data.qpos[:] = layout.default_qpos
-    adr = layout.ball_qpos[0]
-    data.qpos[adr : adr + 3] = [0.0, 0.0, BALL.radius + 0.005]
-    data.ctrl[:] = data.qpos[layout.act_qpos]
-    mujoco.mj_step(model, data, nstep=int(seconds / model.opt.timestep))
-    mujoco.mj_forward(model, data)
-    return model, data, layout
 
 
 def taxels_pressed_by_contacts(model, data, names):
@@ -49,7 +35,7 @@ def taxels_pressed_by_contacts(model, data, names):
 
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_a_resting_ball_presses_the_taxels_under_it_and_no_others(robot):
-    model, data, layout = settled_scene(robot)
+    model, data, layout = ball_resting_on_hand(robot, "taxels")
     names = [model.sensor(i).name for i in range(model.nsensor) if model.sensor(i).name.startswith("taxel_")]
     readings = data.sensordata[layout.taxel_sensor]
     expected = taxels_pressed_by_contacts(model, data, names)

@@ -2,16 +2,15 @@
 
 import math
 
-import mujoco
 import numpy as np
 import pytest
 import torch
 
 import roto
 from roto.envs.observations import FORCE_SCALE, touch_force
-from roto.robots import ROBOTS, get_robot
-from roto.sim.scene import build_scene
+from roto.robots import ROBOTS
 from roto.tasks.bounce import BALL
+from tests.envs.scenes import ball_resting_on_hand
 
 GRAVITY = 9.81
 
@@ -51,22 +50,9 @@ def test_force_touch_changes_no_dynamics_and_reads_zero_at_a_start(robot):
         env.close()
 
 
-def settle_ball_on_hand(robot_name: str, seconds: float = 4.0) -> tuple[mujoco.MjData, object]:
-    """A Bounce ball let down onto the hand held at its default pose, left to come to rest."""
-    robot = get_robot(robot_name)
-    model, layout = build_scene(robot, (BALL,), touch="force")
-    data = mujoco.MjData(model)
-    data.qpos[:] = layout.default_qpos
-    adr = layout.ball_qpos[0]
-    data.qpos[adr : adr + 3] = [0.0, 0.0, BALL.radius + 0.005]
-    data.ctrl[:] = data.qpos[layout.act_qpos]
-    mujoco.mj_step(model, data, nstep=int(seconds / model.opt.timestep))
-    return data, layout
-
-
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_a_ball_resting_on_the_hand_reads_its_weight(robot):
-    data, layout = settle_ball_on_hand(robot)
+    _, data, layout = ball_resting_on_hand(robot, "force", seconds=4.0)
     ball_speed = np.linalg.norm(data.qvel[layout.ball_qvel[0] : layout.ball_qvel[0] + 3])
     assert ball_speed < 1e-3  # at rest
     forces = np.stack([data.sensordata[a + 1 : a + 4] for a in layout.tactile_sensor])  # (n_links, 3) net forces

@@ -127,15 +127,22 @@ def test_sensors_at_more_states_than_worlds_match_the_cpu_backend_and_change_no_
         env.close()
 
 
-@pytest.mark.parametrize("name", ["allegro", "shadow"])
-def test_held_baoding_balls_and_their_lift_read_the_same_on_both_backends(name):
-    envs = [roto.make("baoding", robot=name, num_envs=1, backend=b) for b in ("cpu", "warp")]
-    idx = envs[0]._idx
+def held_baoding_tactile(name: str, touch: str = "binary", steps: int = 20):
+    """(CPU and Warp envs, their tactile observations over ``steps`` steps holding the Baoding balls)."""
+    envs = [roto.make("baoding", robot=name, num_envs=1, backend=b, touch=touch) for b in ("cpu", "warp")]
     hold = envs[0].hold_action()
     tactile = []
     for env in envs:
         env.reset()
-        tactile.append([env.step(hold)[0]["tactile"].clone() for _ in range(20)])
+        tactile.append([env.step(hold)[0]["tactile"].clone() for _ in range(steps)])
+    return envs, tactile
+
+
+@pytest.mark.parametrize("name", ["allegro", "shadow"])
+def test_held_baoding_balls_and_their_lift_read_the_same_on_both_backends(name):
+    envs, tactile = held_baoding_tactile(name)
+    idx = envs[0]._idx
+    hold = envs[0].hold_action()
     for step_cpu, step_warp in zip(*tactile, strict=True):
         assert torch.equal(step_cpu, step_warp)
     n_links = len(envs[0].robot.tactile_links)
@@ -154,12 +161,7 @@ of the force. Measured: 4.6e-5 (Allegro), 1.1e-4 (Shadow) over 20 steps holding 
 
 @pytest.mark.parametrize("name", ["allegro", "shadow"])
 def test_force_touch_reads_the_same_forces_on_both_backends(name):
-    envs = [roto.make("baoding", robot=name, num_envs=1, backend=b, touch="force") for b in ("cpu", "warp")]
-    hold = envs[0].hold_action()
-    tactile = []
-    for env in envs:
-        env.reset()
-        tactile.append([env.step(hold)[0]["tactile"].clone() for _ in range(20)])
+    envs, tactile = held_baoding_tactile(name, "force")
     for step_cpu, step_warp in zip(*tactile, strict=True):
         assert torch.equal(step_cpu > 0, step_warp > 0)  # the same links touched
         assert float((step_cpu - step_warp).abs().max()) < FORCE_TOUCH_TOLERANCE
@@ -170,12 +172,7 @@ def test_force_touch_reads_the_same_forces_on_both_backends(name):
 
 @pytest.mark.parametrize("name", ["allegro", "shadow"])
 def test_taxels_light_the_same_on_both_backends(name):
-    envs = [roto.make("baoding", robot=name, num_envs=1, backend=b, touch="taxels") for b in ("cpu", "warp")]
-    hold = envs[0].hold_action()
-    tactile = []
-    for env in envs:
-        env.reset()
-        tactile.append([env.step(hold)[0]["tactile"].clone() for _ in range(20)])
+    envs, tactile = held_baoding_tactile(name, "taxels")
     for step_cpu, step_warp in zip(*tactile, strict=True):
         assert torch.equal(step_cpu, step_warp)
     n_links = len(envs[0].robot.tactile_links)
