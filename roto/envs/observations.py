@@ -51,6 +51,28 @@ def touch_force(net_force: torch.Tensor, scale: float = FORCE_SCALE) -> torch.Te
     return torch.log1p(torch.linalg.vector_norm(net_force, dim=-1) / scale).to(torch.float32)
 
 
+def tactile_frame(
+    touch: str, link_force: torch.Tensor, taxel_force: torch.Tensor | None, threshold: float
+) -> torch.Tensor:
+    """The tactile group of one frame in touch mode ``touch`` (``TOUCH_MODES``).
+
+    Args:
+        link_force: per tactile link, (B, n_links) its strongest contact's normal force, or with
+            ``force`` touch (B, n_links, 3) its net contact force.
+        taxel_force: (B, n_taxels) each taxel's normal force (``taxels`` touch only).
+        threshold: force (N) above which a link or a taxel counts as touched.
+
+    Returns:
+        (B, n_links) float32, or (B, n_links + n_taxels) with ``taxels``; NaN and inf read as 0.
+    """
+    if touch == "force":
+        return touch_force(link_force).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0)
+    bits = tactile_bits(link_force, threshold)
+    if touch == "taxels":
+        return torch.cat([bits, tactile_bits(taxel_force, threshold)], dim=-1)
+    return bits
+
+
 def proprio_parts(qpos, qvel, lo, hi, target, actuated_qpos, velocity_scale: float = JOINT_VELOCITY_SCALE):
     """The computed parts of proprioception, with arithmetic operators only, so that numpy arrays
     and torch tensors both work: normalised positions, scaled velocities, command error.

@@ -12,7 +12,7 @@ import functools
 import math
 import operator
 from dataclasses import dataclass
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
@@ -28,13 +28,13 @@ from roto.envs.observations import (
     FrameStack,
     privileged_frame,
     proprio_frame,
-    tactile_bits,
-    touch_force,
+    tactile_frame,
 )
+from roto.envs.selections import Selected, Selections
 from roto.envs.start_pool import StartPool, draw_valid_starts
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
-from roto.sim.backend import SimState, make_backend
+from roto.sim.backend import make_backend
 from roto.sim.host_sync import deliberate_host_sync
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
@@ -51,25 +51,6 @@ def resolve_device(device: str | torch.device) -> torch.device:
 
 DEVICE_CHECK_EVERY = 16
 """Steps between the host reads of a GPU env (pool of starts, action finiteness)."""
-
-
-class Selected(NamedTuple):
-    """The columns of a batch of n physics states that the task and the observations read."""
-
-    obs_qpos: torch.Tensor  # (n, n_obs) observed joint positions
-    obs_qvel: torch.Tensor  # (n, n_obs) their velocities
-    act_qpos: torch.Tensor  # (n, n_act) actuated joint positions
-    ball_pos: torch.Tensor  # (n, n_ball, 3) ball centres
-    ball_vel: torch.Tensor  # (n, n_ball, 3) ball linear velocities
-    ball_force: torch.Tensor  # (n, substeps, n_ball) ball-hand normal force of every substep
-    tactile_force: torch.Tensor  # last substep: (n, n_links) normal force, or (n, n_links, 3) net force (force touch)
-    taxel_force: torch.Tensor | None = None  # last substep: (n, n_taxels) each taxel's normal force (taxel touch)
-
-
-def _is_view_of(tensor: torch.Tensor, bases: tuple[torch.Tensor, ...]) -> bool:
-    """Whether ``tensor`` shares its memory with one of ``bases`` (a view, not a copy)."""
-    ptr = tensor.untyped_storage().data_ptr()
-    return any(ptr == base.untyped_storage().data_ptr() for base in bases)
 
 
 @dataclass
@@ -122,18 +103,7 @@ class RotoEnv:
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
-        idx = self._idx
-        # (columns, source) per field of Selected; sources: 0 qpos, 1 qvel, 2 sensors, 3 last substep's
-        self._selections = (
-            (idx.obs_qpos, 0),
-            (idx.obs_qvel, 1),
-            (idx.act_qpos, 0),
-            (idx.ball_pos, 0),
-            (idx.ball_vel, 1),
-            (idx.ball_force, 2),
-            (idx.tactile_force, 3),
-        ) + (((idx.taxels, 3),) if config.touch == "taxels" else ())
-        self._selected_cache: tuple | None = None
+        self._selections = Selections(self._idx, self.device, taxels=config.touch == "taxels")
         # reading the device is free on the CPU and waits for a GPU. A sync-free step reads nothing:
         # resets run masked every step, and the pool of starts and the action check are read every
         # `check_every` steps, the pool holding enough starts for every world to reset on each of
@@ -183,7 +153,7 @@ class RotoEnv:
         self._last_action = action.to(torch.float32, copy=True)  # never alias the caller's tensor
 
         sim = self.backend.step(self._target)
-        selected = self._selected_of(sim)
+        selected = self._selections.of(sim)
         diverged = sim.diverged.to(self.device)
 
         inputs = self._task_inputs(selected)
@@ -339,38 +309,6 @@ class RotoEnv:
                     "actions must be finite (on a GPU they are checked every few steps, not before each one)"
                 )
 
-    def _select(self, qpos: torch.Tensor, qvel: torch.Tensor, sensors: torch.Tensor) -> Selected:
-        """The env's columns of physics states: ``qpos`` (n, nq), ``qvel`` (n, nv) and ``sensors``
-        (n, substeps, nsensordata), the last substep's being the current ones."""
-        sources = (qpos, qvel, sensors, sensors[:, -1])
-        return Selected(*(columns.take(sources[k]) for columns, k in self._selections))
-
-    def _selected_of(self, sim: SimState) -> Selected:
-        """``_select`` of a step's physics state. A backend that hands out the same tensors every
-        step (the CPU one: views of arrays it writes in place) gets the selections that are views
-        made once, as they read each step's values; only copies (a gather) are made each step."""
-        cached = self._selected_cache
-        if cached is not None and cached[0] is sim.qpos and cached[1] is sim.qvel and cached[2] is sim.sensordata:
-            selected, copies = cached[3], cached[4]
-            if not copies:
-                return selected
-            sources = (sim.qpos, sim.qvel, sim.sensordata, sim.sensordata[:, -1])
-            values = list(selected)
-            for i in copies:
-                columns, k = self._selections[i]
-                values[i] = columns.take(sources[k])
-            return Selected(*values)
-        f64 = torch.float64
-        qpos = sim.qpos.to(self.device, f64)
-        qvel = sim.qvel.to(self.device, f64)
-        sensors = sim.sensordata.to(self.device, f64)
-        selected = self._select(qpos, qvel, sensors)
-        if qpos is sim.qpos and qvel is sim.qvel and sensors is sim.sensordata:  # no conversion copied them
-            bases = (qpos, qvel, sensors)
-            copies = tuple(i for i in range(len(self._selections)) if not _is_view_of(selected[i], bases))
-            self._selected_cache = (sim.qpos, sim.qvel, sim.sensordata, selected, copies)
-        return selected
-
     def _task_inputs(self, selected: Selected) -> TaskInputs:
         # views of the backend's state: read before the step's resets overwrite it
         contact = (selected.ball_force > self.config.tactile_threshold).any(dim=1)
@@ -388,21 +326,12 @@ class RotoEnv:
         idx = self._idx
         groups: dict[str, torch.Tensor] = {}
         if "tactile" in self.groups:
-            if self.config.touch == "force":
-                groups["tactile"] = touch_force(selected.tactile_force).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0)
-            else:
-                groups["tactile"] = tactile_bits(selected.tactile_force, self.config.tactile_threshold)
-            if self.config.touch == "taxels":
-                taxels = tactile_bits(selected.taxel_force, self.config.tactile_threshold)
-                groups["tactile"] = torch.cat([groups["tactile"], taxels], dim=-1)
+            config = self.config
+            groups["tactile"] = tactile_frame(
+                config.touch, selected.tactile_force, selected.taxel_force, config.tactile_threshold
+            )
         groups["proprio"] = proprio_frame(
-            selected.obs_qpos,
-            selected.obs_qvel,
-            idx.obs_lo,
-            idx.obs_hi,
-            target,
-            selected.act_qpos,
-            last_action,
+            selected.obs_qpos, selected.obs_qvel, idx.obs_lo, idx.obs_hi, target, selected.act_qpos, last_action
         ).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0)
         if "privileged" in self.groups:
             groups["privileged"] = privileged_frame(inputs.ball_pos, inputs.ball_vel).nan_to_num_(
@@ -446,7 +375,7 @@ class RotoEnv:
         qvel = qpos.new_zeros(n, self.model.nv)
         target = idx.act_qpos.take(qpos).clone()
         sensors = self.backend.sensors_at(qpos, qvel, target).to(self.device, torch.float64)
-        selected = self._select(qpos, qvel, sensors[:, None])
+        selected = self._selections.select(qpos, qvel, sensors[:, None])
         inputs = TaskInputs(ball_pos=selected.ball_pos, ball_vel=selected.ball_vel, ball_contact=torch.zeros(0))
         last_action = torch.zeros(n, self.num_actions, dtype=torch.float32, device=self.device)
         frame = self._frame(selected, inputs, target, last_action)

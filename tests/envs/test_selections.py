@@ -4,7 +4,7 @@ slow reference: selections made afresh from copies of the same state, every step
 import pytest
 import torch
 
-from roto.envs.roto_env import Selected
+from roto.envs.selections import Selected
 from roto.registry import list_envs, make
 
 
@@ -17,8 +17,8 @@ def test_cached_selections_read_each_steps_state(task, robot):
     for _ in range(40):
         action = torch.rand(3, env.num_actions, generator=gen, dtype=torch.float64) * 2 - 1
         sim = env.backend.step(action * 0.2 + env._target)
-        cached = env._selected_of(sim)
-        reference = env._select(sim.qpos.clone(), sim.qvel.clone(), sim.sensordata.clone())
+        cached = env._selections.of(sim)
+        reference = env._selections.select(sim.qpos.clone(), sim.qvel.clone(), sim.sensordata.clone())
         for name, got, want in zip(Selected._fields, cached, reference, strict=True):
             if name == "taxel_force":  # only with taxel touch
                 assert got is None and want is None
@@ -26,11 +26,11 @@ def test_cached_selections_read_each_steps_state(task, robot):
                 assert torch.equal(got, want), name
         first = first or cached
     # the views were made once and reused (only gathered columns are made again)
-    copies = env._selected_cache[4]
-    for i, name in enumerate(Selected._fields[: len(env._selections)]):
+    copies = env._selections.cache[4]
+    for i, name in enumerate(Selected._fields[: len(env._selections.table)]):
         if i not in copies:
             assert cached[i] is first[i], name
-    assert len(copies) < len(env._selections)
+    assert len(copies) < len(env._selections.table)
     env.close()
 
 
@@ -38,8 +38,8 @@ def test_taxel_selections_are_cached_views_too():
     env = make("bounce", robot="allegro", num_envs=2, seed=0, touch="taxels")
     env.reset(seed=0)
     sims = [env.backend.step(env._target) for _ in range(3)]
-    selected = [env._selected_of(sim) for sim in sims]
-    reference = env._select(sims[-1].qpos.clone(), sims[-1].qvel.clone(), sims[-1].sensordata.clone())
+    selected = [env._selections.of(sim) for sim in sims]
+    reference = env._selections.select(sims[-1].qpos.clone(), sims[-1].qvel.clone(), sims[-1].sensordata.clone())
     assert torch.equal(selected[-1].taxel_force, reference.taxel_force)
     assert selected[-1].taxel_force is selected[1].taxel_force  # a view made once
     env.close()
@@ -50,7 +50,7 @@ def test_a_backend_that_copies_gets_fresh_selections_each_step():
     env.reset(seed=0)
     sim = env.backend.step(env._target)
     float32_sim = type(sim)(sim.qpos.float(), sim.qvel.float(), sim.sensordata.float(), sim.diverged)
-    env._selected_cache = None
-    env._selected_of(float32_sim)
-    assert env._selected_cache is None  # converted copies are never cached
+    env._selections.cache = None
+    env._selections.of(float32_sim)
+    assert env._selections.cache is None  # converted copies are never cached
     env.close()

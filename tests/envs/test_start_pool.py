@@ -61,7 +61,7 @@ def first_frame_from_world(env, world: int) -> dict[str, torch.Tensor]:
     qvel = torch.from_numpy(env.backend.qvel[world : world + 1].copy())
     target = env._target[world : world + 1]
     sensors = env.backend.sensors_at(qpos, qvel, target).to(torch.float64)
-    selected = env._select(qpos, qvel, sensors[:, None])
+    selected = env._selections.select(qpos, qvel, sensors[:, None])
     return env._frame(selected, env._task_inputs(selected), target, torch.zeros(1, env.num_actions))
 
 
