@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 from roto.cli import main
-from roto.rl.runner import load_policy
+from roto.rl.runner import Trainer, load_policy
 
 TINY = [
     "network.encoder=[16]",
@@ -168,3 +168,8 @@ def test_a_force_touch_run_keeps_its_touch_through_eval(tmp_path, capsys):
     assert main(["eval", "--checkpoint", str(ckpt), "--episodes", "2", "--out", str(tmp_path / "e.json")]) == 0
     _, settings, _ = load_policy(ckpt)
     assert settings.env.touch == "force"
+    trainer = Trainer.resume(run_dir)  # the learner the run trains with decodes force touch with MSE
+    (reconstruction,) = trainer.alg.aux_losses
+    assert not reconstruction.binary_tactile
+    trainer.env.close()
+    trainer.evaluator.env.close()

@@ -79,7 +79,7 @@ def build_learner(
     num_envs: int,
     agent: AgentConfig,
     seed: int,
-    touch: str = "binary",
+    touch: str,
 ) -> PPO:
     """PPO with its rollout buffer (every group in ``sizes``), generator and auxiliary losses
     (``touch``: the env's touch signal, for a reconstruction of the tactile group)."""

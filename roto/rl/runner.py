@@ -98,7 +98,7 @@ class Trainer:
         sizes = stacked_sizes(self.env)
         self.model = build_model(sizes, self.env.num_actions, agent, settings.env.obs_mode).to(self.device)
         self.alg = build_learner(
-            self.model, sizes, self.env.num_actions, settings.env.num_envs, agent, settings.env.seed
+            self.model, sizes, self.env.num_actions, settings.env.num_envs, agent, settings.env.seed, settings.env.touch
         )
         self.episodes = EpisodeStats(self.env.task.metric_names, self.device)
         self.update = 0

@@ -18,7 +18,7 @@ def build_aux_losses(
     sizes: Mapping[str, int],
     num_actions: int,
     samples_per_rollout: int,
-    touch: str = "binary",
+    touch: str,
 ) -> list[AuxLoss]:
     """The enabled losses of ``config``, each with its heads on the model's device and its own Adam.
 
