@@ -72,8 +72,8 @@ class SingleWorldStep:
     def __init__(self, env: RotoEnv) -> None:
         if not supports_single_world_step(env):
             raise ValueError(
-                f"SingleWorldStep needs one world on the CPU backend, got num_envs={env.num_envs}, "
-                f"device={env.device}, backend={type(env.backend).__name__}"
+                f"SingleWorldStep needs one world on the CPU backend with binary touch, got num_envs={env.num_envs}, "
+                f"device={env.device}, backend={type(env.backend).__name__}, touch={env.config.touch!r}"
             )
         self.env = env
         idx, backend = env._idx, env.backend
@@ -103,9 +103,8 @@ class SingleWorldStep:
         """One control step from ``action`` (a float array of num_actions values)."""
         env = self.env
         array = np.asarray(action)
-        if array.dtype.kind != "f":
-            raise TypeError(f"action dtype {array.dtype} is not floating point; use float32 or float64")
-        if env._needs_reset or array.size != self._num_actions or not np.isfinite(array).all():
+        unusual = array.dtype.kind != "f" or array.size != self._num_actions or not np.isfinite(array).all()
+        if env._needs_reset or unusual:
             return self._reference_step(array)  # raises the env's own error
         row = array.reshape(1, -1)
         clamped = np.minimum(np.maximum(row.astype(np.float64), -1.0), 1.0)

@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 import torch
 
-from roto.envs.observations import FORCE_SCALE, touch_force
+from roto.envs.observations import FORCE_SCALE, tactile_frame
 from roto.envs.roto_env import RotoEnv
 from roto.rl.networks import ActorCritic
 from roto.rl.settings import TrainSettings
@@ -76,25 +76,29 @@ class TactileFrameRenderer:
             self.model, self.data, self.env.backend.physics_state()[0], mujoco.mjtState.mjSTATE_FULLPHYSICS
         )
         mujoco.mj_forward(self.model, self.data)
+        values, pressed = self._touch()
         self.model.geom_rgba[:] = self._base_rgba
-        for geoms, rgba in zip(self._link_geoms, self._touch_colours(), strict=True):
+        for geoms, rgba in zip(self._link_geoms, self._touch_colours(values), strict=True):
             if rgba is not None:
                 self.model.geom_rgba[geoms] = rgba
         self.model.site_rgba[self._taxel_sites] = 0.0  # only pressed taxels are drawn
-        pressed = self.data.sensordata[self.env.layout.taxel_sensor] > self.env.config.tactile_threshold
         self.model.site_rgba[self._taxel_sites[pressed]] = TAXEL_RGBA
         self.renderer.update_scene(self.data, camera=self.camera, scene_option=self._option)
         return self.renderer.render().copy()
 
-    def _touch_colours(self) -> list[np.ndarray | None]:
-        """Per tactile link, its colour if it is touching (after ``mj_forward``), else None."""
-        sensors = self.data.sensordata
-        if self.env.config.touch == "force":
-            net = sensors[self.env.layout.tactile_sensor[:, None] + 1 + np.arange(3)]
-            values = touch_force(torch.from_numpy(net)[None])[0].numpy()
-            return [rgba if value > 0 else None for value, rgba in zip(values, force_touch_rgba(values), strict=True)]
-        force = sensors[self.env.layout.tactile_sensor + 1]
-        return [TOUCH_RGBA if f > self.env.config.tactile_threshold else None for f in force.tolist()]
+    def _touch(self) -> tuple[np.ndarray, np.ndarray]:
+        """(per tactile link its touch value, per taxel whether it is pressed) after ``mj_forward``,
+        read as the env reads them (``tactile_frame`` of the env's sensor columns)."""
+        env, sensors = self.env, torch.from_numpy(self.data.sensordata)[None]
+        links = env._idx.tactile_force.take(sensors)
+        values = tactile_frame(env.config.touch, links, env._idx.taxels.take(sensors), env.config.tactile_threshold)
+        n_links = len(env.robot.tactile_links)
+        return values[0, :n_links].numpy(), values[0, n_links:].numpy() > 0
+
+    def _touch_colours(self, values: np.ndarray) -> list[np.ndarray | None]:
+        """Per tactile link, its colour if it is touching, else None."""
+        colours = force_touch_rgba(values) if self.env.config.touch == "force" else [TOUCH_RGBA] * len(values)
+        return [rgba if value > 0 else None for value, rgba in zip(values, colours, strict=True)]
 
     def close(self) -> None:
         """Free the GL context and restore the colours."""

@@ -133,11 +133,9 @@ def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...], touch: str =
 def hand_taxels(robot: RobotSpec) -> list[Taxel]:
     """The hand's taxels, in observation order: each fingertip (``tip_bodies``, then the thumb's),
     then the palm (``roto.sim.taxels``), laid out at the default pose in the task frame."""
-    spec = build_hand(robot)
-    model = spec.compile()
+    model = build_hand(robot).compile()
     data = mujoco.MjData(model)
-    for joint, angle in robot.default_pose.items():
-        data.qpos[model.joint(joint).qposadr[0]] = angle
+    data.qpos[:] = default_pose_qpos(model, robot)
     mujoco.mj_kinematics(model, data)
     above_palm = np.array([0.0, 0.0, 0.05])  # task frame: palm centre at the origin, z up
     taxels = []
@@ -145,6 +143,14 @@ def hand_taxels(robot: RobotSpec) -> list[Taxel]:
         taxels += pad_grid(model, data, tip, above_palm - data.body(tip).xpos, FINGERTIP_GRID)
     palm = model.body(model.geom(robot.palm_geom).bodyid[0]).name
     return taxels + pad_grid(model, data, palm, np.array([0.0, 0.0, 1.0]), PALM_GRID)
+
+
+def default_pose_qpos(model: mujoco.MjModel, robot: RobotSpec) -> np.ndarray:
+    """(nq,) the model's reference qpos with the hand's joints at ``robot.default_pose``."""
+    qpos = model.qpos0.copy()
+    for joint, angle in robot.default_pose.items():
+        qpos[model.joint(joint).qposadr[0]] = angle
+    return qpos
 
 
 def _add_taxel(spec: mujoco.MjSpec, name: str, taxel: Taxel) -> None:
@@ -176,9 +182,7 @@ def scene_layout(model: mujoco.MjModel, robot: RobotSpec, balls: tuple[BallSpec,
     if act_order != list(range(model.nu)):
         raise ValueError(f"robot {robot.name!r}: actuator order must follow actuated_joints, got {act_order}")
 
-    default_qpos = model.qpos0.copy()
-    for joint, angle in robot.default_pose.items():
-        default_qpos[model.joint(joint).qposadr[0]] = angle
+    default_qpos = default_pose_qpos(model, robot)
 
     def sensor_adr(name: str) -> int:
         return int(model.sensor_adr[model.sensor(name).id])
