@@ -27,24 +27,25 @@ def _add_touch_arg(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--touch",
         default="binary",
-        help="tactile signal per link: binary (a touch bit, the benchmark's; default) or force "
-        "(log(1 + |F| / 0.1 N) of the link's net contact force)",
+        help="tactile signal: binary (a touch bit per link, the benchmark's; default), force "
+        "(log(1 + |F| / 0.1 N) of each link's net contact force) or taxels (the link bits, then a bit "
+        "per taxel of the fingertip pads and the palm)",
     )
 
 
 def _cmd_list(args: argparse.Namespace) -> int:
     import roto
     from roto.registry import gym_id
+    from roto.robots import ROBOTS, get_robot
     from roto.sim.scene import hand_taxels
 
     header = f"{'task':<9} {'robot':<12} {'gymnasium id':<30} {'actions':>7} {'frame (blind)':>13} {'stacked':>8}"
     print(f"{header} {'taxels':>6} {'frame (taxels)':>14}")
-    taxels = {}
+    taxels = {robot: len(hand_taxels(get_robot(robot))) for robot in ROBOTS}
     for task, robot in roto.list_envs():
         env = roto.make(task, robot=robot, num_envs=1)
         frame = sum(env.frame_sizes.values())
         stacked = frame * env.config.frame_stack
-        taxels[robot] = taxels.get(robot) or len(hand_taxels(env.robot))
         row = f"{task:<9} {robot:<12} {gym_id(task, robot):<30} {env.num_actions:>7} {frame:>13} {stacked:>8}"
         print(f"{row} {taxels[robot]:>6} {frame + taxels[robot]:>14}")
         env.close()
