@@ -1,22 +1,25 @@
 #!/usr/bin/env bash
 # Every GPU figure of the Warp backend in one command (one sitting of a GPU machine; docs/backends.md
 # says how to bring the packages to an offline one).
-#   usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS]
+#   usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS] [TRAIN_OVERRIDES...]
 # Writes into OUT_DIR:
 #   gpu.txt           the GPU's name, memory and driver
 #   pytest_gpu.txt    `pytest -m gpu`: every pair stepped and a short training under sync-debug "error"
 #   bench_warp.jsonl  `roto bench` of all 8 (task, robot) pairs at NUM_ENVS (default 8192)
 #   scaling.jsonl     Shadow Bounce at 1k, 4k, 8k, 16k and 32k envs
+#   update_cost.jsonl one PPO update of blind Shadow Bounce at NUM_ENVS: eager, CUDA graph, each with
+#                     and without TF32 (benchmarks/update_cost.py)
 #   train_bounce_shadow/  if TRAIN_SECONDS > 0: blind Shadow Bounce at NUM_ENVS, stopped after that many
 #                     seconds (scalars.csv: perf/steps_per_s; evaluations.jsonl: the evaluation curve),
 #                     with policy_best.pt / policy_latest.pt (weights and settings only, for `roto eval`
-#                     and `roto play` elsewhere)
+#                     and `roto play` elsewhere); TRAIN_OVERRIDES go to `roto train` (ppo.cuda_graph=true)
 #   suite.log         one line per step: exit status and seconds
 # Exits non-zero, naming the failed steps and the tail of their error output, if any step failed.
 set -uo pipefail
-out=${1:?usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS]}
+out=${1:?usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS] [TRAIN_OVERRIDES...]}
 train_s=${2:-0}
 num_envs=${3:-8192}
+train_overrides=("${@:4}")
 export ROTO_WARP_CACHE=${ROTO_WARP_CACHE:-/tmp/roto-warp-cache}
 mkdir -p "$out"
 failed=()
@@ -33,7 +36,8 @@ step() {  # step NAME STDOUT_FILE COMMAND...: run it, log status and time, remem
 
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv > "$out/gpu.txt" 2>&1 || failed+=(nvidia-smi)
 step pytest_gpu "$out/pytest_gpu.txt" python3 -m pytest -q -m gpu -p no:cacheprovider \
-  tests/envs/test_sync_free_step.py tests/rl/test_training_gpu.py
+  tests/envs/test_sync_free_step.py tests/rl/test_training_gpu.py tests/rl/test_graphed_step.py
+step update_cost "$out/update_cost.jsonl" python3 benchmarks/update_cost.py --device cuda --num_envs "$num_envs"
 for task in bounce baoding; do
   for robot in shadow shadow_lite allegro orca; do
     step "bench_${task}_${robot}" "$out/bench_warp.jsonl" python3 -m roto.cli bench --backend warp --device cuda \
@@ -49,7 +53,7 @@ if [ "$train_s" -gt 0 ]; then
   # SIGINT at the time limit ends the run like Ctrl-C (exit 124 from timeout is the expected end)
   timeout --signal=INT "$train_s" python3 -m roto.cli train --backend warp --device cuda --task bounce \
     --robot shadow --obs blind --num_envs "$num_envs" --steps 200000000 --seed 0 --run_dir "$run" \
-    --no_progress > "$out/train.log" 2>&1
+    --no_progress "${train_overrides[@]}" > "$out/train.log" 2>&1
   status=$?
   echo "train: exit $status after at most $train_s s" | tee -a "$out/suite.log"
   if [ "$status" -ne 0 ] && [ "$status" -ne 124 ]; then failed+=(train); fi

@@ -15,6 +15,7 @@ from torch import nn
 
 from roto.rl.config import PPOConfig
 from roto.rl.gae import compute_gae
+from roto.rl.graphed_step import GraphedMinibatchStep
 from roto.rl.losses import kl_adaptive_lr, ppo_terms, weighted_sum
 from roto.rl.networks import ActorCritic, Obs
 from roto.rl.normalizers import RunningStandardScaler
@@ -26,6 +27,23 @@ def explained_variance(prediction: torch.Tensor, target: torch.Tensor) -> torch.
     """1 - Var(target - prediction) / Var(target) over all elements (nan if the target is constant)."""
     var = target.var()
     return 1.0 - (target - prediction).var() / var if var > 0 else torch.tensor(float("nan"))
+
+
+def check_graphable(config: PPOConfig, storage: RolloutBuffer, aux_losses: list[AuxLoss]) -> None:
+    """Raise ValueError unless ``ppo.cuda_graph`` can run: no auxiliary losses, minibatches of one
+    size, a CUDA device."""
+    if aux_losses:
+        names = [aux.name for aux in aux_losses]
+        raise ValueError(f"ppo.cuda_graph=true does not graph auxiliary losses yet; set it false or drop ssl: {names}")
+    samples = storage.steps * storage.num_envs
+    if samples % config.minibatches:
+        raise ValueError(
+            f"ppo.cuda_graph=true needs minibatches of one size: ppo.rollouts x num_envs = {samples} "
+            f"is not divisible by ppo.minibatches={config.minibatches}"
+        )
+    device = storage.values.device
+    if device.type != "cuda":
+        raise ValueError(f"ppo.cuda_graph=true needs the envs on a CUDA device, got device={str(device)!r}")
 
 
 class PPO:
@@ -49,8 +67,16 @@ class PPO:
     ) -> None:
         self.model, self.config, self.storage, self.generator = model, config, storage, generator
         self.aux_losses = list(aux_losses or [])
-        self.optimizer = torch.optim.Adam(model.parameters(), lr=config.lr)
         self.lr = config.lr
+        self._graphed: GraphedMinibatchStep | None = None
+        if config.cuda_graph:
+            check_graphable(config, storage, self.aux_losses)
+            # a KL-adaptive lr must be a device tensor the graph reads, changed in place
+            lr = torch.tensor(config.lr, device=storage.values.device) if config.kl_adaptive else config.lr
+            self.optimizer = torch.optim.Adam(model.parameters(), lr=lr, capturable=True)
+            self._graphed = GraphedMinibatchStep(lambda batch: self._minibatch_step(batch, []), model, self.optimizer)
+        else:
+            self.optimizer = torch.optim.Adam(model.parameters(), lr=config.lr)
         self.value_scaler = None
         if config.value_normalization:
             self.value_scaler = RunningStandardScaler(1, clip=None).to(storage.values.device)
@@ -125,8 +151,11 @@ class PPO:
             active = [aux for aux in self.aux_losses if epoch < aux_epochs(c.epochs, aux.config.epoch_ratio)]
             epoch_kl = []
             for i, batch in enumerate(buffer.minibatches(c.minibatches, self.generator)):
-                metrics = self._minibatch_step(batch, [(aux, aux_batches[aux.name][i]) for aux in active])
-                epoch_kl.append(metrics["ppo/approx_kl"])
+                if self._graphed is not None:
+                    metrics = self._graphed(batch)  # its tensors are overwritten by the next minibatch
+                else:
+                    metrics = self._minibatch_step(batch, [(aux, aux_batches[aux.name][i]) for aux in active])
+                epoch_kl.append(metrics["ppo/approx_kl"].clone())
                 for name, value in metrics.items():
                     sums[name] = sums.get(name, 0.0) + value
                     counts[name] = counts.get(name, 0) + 1
@@ -181,7 +210,10 @@ class PPO:
         c = self.config
         self.lr = kl_adaptive_lr(self.lr, kl, c.kl_target, c.kl_factor, c.lr_min, c.lr_max)
         for group in self.optimizer.param_groups:
-            group["lr"] = self.lr
+            if torch.is_tensor(group["lr"]):
+                group["lr"].fill_(self.lr)  # the tensor a CUDA graph reads
+            else:
+                group["lr"] = self.lr
 
     # ------------------------------------------------------------------------ checkpoints
 

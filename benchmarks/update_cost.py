@@ -1,0 +1,96 @@
+"""What one PPO update costs at a training setting's shapes, eager against replayed from a CUDA graph.
+
+    python benchmarks/update_cost.py --device cuda --num_envs 8192 [--agent_cfg bounce] [--updates 6]
+
+Builds the learner of blind (task, robot) with the packaged agent config, fills its rollout buffer
+with made-up observations and rewards (no simulation: this isolates the update), and times
+``update()`` per variant, one JSON line each: the median seconds per update over the updates after
+the first (the first compiles, captures and warms up) and the samples per second that makes.
+Variants on a CUDA device: ``eager``, ``cuda_graph`` (``ppo.cuda_graph=true``) and both again with
+TF32 matrix products (``torch.backends.cuda.matmul.allow_tf32``); on the CPU: ``eager``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+
+import torch
+
+from roto.envs.config import EnvConfig
+from roto.envs.roto_env import RotoEnv
+from roto.rl.build import build_learner, build_model, stacked_sizes
+from roto.rl.config import load_agent_config
+from roto.rl.ppo import PPO
+
+
+def fill(alg: PPO, sizes: dict[str, int], generator: torch.Generator) -> None:
+    """One rollout of standard-normal observations and rewards, 5 % episode ends, then the returns."""
+    buffer, device = alg.storage, alg.storage.values.device
+
+    def obs() -> dict[str, torch.Tensor]:
+        return {g: torch.randn(buffer.num_envs, d, device=device, generator=generator) for g, d in sizes.items()}
+
+    for _ in range(buffer.steps):
+        alg.act(obs())
+        reward = torch.randn(buffer.num_envs, device=device, generator=generator)
+        done = torch.rand(buffer.num_envs, device=device, generator=generator) < 0.05
+        alg.process_step(reward, done, torch.zeros_like(done), {})
+    alg.compute_returns(obs())
+
+
+def measure(args: argparse.Namespace, graphed: bool, tf32: bool) -> dict[str, object]:
+    """Median seconds per update of one variant."""
+    device = torch.device(args.device)
+    torch.backends.cuda.matmul.allow_tf32 = tf32
+    probe = RotoEnv(EnvConfig(task=args.task, robot=args.robot, num_envs=1))
+    sizes, num_actions = stacked_sizes(probe), probe.num_actions
+    agent = load_agent_config(args.task, args.agent_cfg, [f"ppo.cuda_graph={str(graphed).lower()}"])
+    torch.manual_seed(0)
+    model = build_model(sizes, num_actions, agent, "blind").to(device)
+    alg = build_learner(model, sizes, num_actions, args.num_envs, agent, seed=0, touch="binary")
+    generator = torch.Generator(device=device).manual_seed(0)
+    seconds = []
+    for _ in range(args.updates):
+        fill(alg, sizes, generator)
+        if device.type == "cuda":
+            torch.cuda.synchronize()
+        start = time.perf_counter()
+        alg.update()  # ends with host reads of its metrics, so the device is done when it returns
+        seconds.append(time.perf_counter() - start)
+    median = statistics.median(seconds[1:])
+    samples = agent.ppo.rollouts * args.num_envs * agent.ppo.epochs
+    return {
+        "variant": ("cuda_graph" if graphed else "eager") + ("_tf32" if tf32 else ""),
+        "task": args.task,
+        "robot": args.robot,
+        "agent_cfg": args.agent_cfg or args.task,
+        "num_envs": args.num_envs,
+        "device": torch.cuda.get_device_name(device) if device.type == "cuda" else "cpu",
+        "minibatch_steps": agent.ppo.epochs * agent.ppo.minibatches,
+        "update_s": round(median, 5),
+        "first_update_s": round(seconds[0], 3),
+        "samples_per_s": round(samples / median),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--task", default="bounce")
+    parser.add_argument("--robot", default="shadow")
+    parser.add_argument("--agent_cfg", default=None, help="packaged agent config (default: the task's)")
+    parser.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
+    parser.add_argument("--num_envs", type=int, default=8192)
+    parser.add_argument("--updates", type=int, default=6, help="timed updates per variant (the first is dropped)")
+    args = parser.parse_args()
+    if args.updates < 2:
+        parser.error(f"--updates must be >= 2 (the first one is not counted), got {args.updates}")
+    on_gpu = args.device != "cpu"
+    for graphed, tf32 in [(False, False), (True, False), (False, True), (True, True)] if on_gpu else [(False, False)]:
+        print(json.dumps(measure(args, graphed, tf32)), flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,94 @@
+"""``ppo.cuda_graph``: the graphed update trains as the eager one does (on a GPU), and a setting it
+cannot run is refused before any training (everywhere)."""
+
+import pytest
+import torch
+
+from roto.rl.build import build_learner, build_model
+from roto.rl.config import load_agent_config
+from roto.rl.graphed_step import clone_tree, copy_tree
+
+SIZES = {"proprio": 12, "tactile": 4}
+NUM_ACTIONS = 3
+NUM_ENVS = 64
+needs_cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="needs an NVIDIA GPU")
+
+
+def learner(device, overrides):
+    agent = load_agent_config("bounce", overrides=["ppo.rollouts=4", "ppo.epochs=3", "ppo.minibatches=4", *overrides])
+    torch.manual_seed(0)
+    model = build_model(SIZES, NUM_ACTIONS, agent, "blind").to(device)
+    return build_learner(model, SIZES, NUM_ACTIONS, NUM_ENVS, agent, seed=0, touch="binary")
+
+
+def fill(alg, device, seed):
+    """One rollout of made-up observations and rewards, then the returns."""
+    data = torch.Generator(device="cpu").manual_seed(seed)
+    for _ in range(alg.storage.steps):
+        obs = {g: torch.randn(NUM_ENVS, d, generator=data).to(device) for g, d in SIZES.items()}
+        alg.act(obs)
+        reward = torch.randn(NUM_ENVS, generator=data).to(device)
+        done = (torch.rand(NUM_ENVS, generator=data) < 0.1).to(device)
+        alg.process_step(reward, done, torch.zeros_like(done), {})
+    alg.compute_returns({g: torch.randn(NUM_ENVS, d, generator=data).to(device) for g, d in SIZES.items()})
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        ([], "needs the envs on a CUDA device, got device='cpu'"),
+        (["ppo.minibatches=3"], "ppo.rollouts x num_envs = 256 is not divisible by ppo.minibatches=3"),
+        (["ssl.forward_dynamics={seq_length: 2}"], "does not graph auxiliary losses yet; set it false or drop ssl"),
+    ],
+)
+def test_a_setting_the_graph_cannot_run_is_refused_naming_it(overrides, message):
+    with pytest.raises(ValueError, match=r"ppo\.cuda_graph=true") as error:
+        learner(torch.device("cpu"), ["ppo.cuda_graph=true", *overrides])
+    assert message in str(error.value)
+
+
+def test_inputs_are_copied_in_place_and_a_changed_shape_is_refused():
+    batch = {"obs": {"proprio": torch.ones(4, 2)}, "actions": torch.zeros(4, 1)}
+    inputs = clone_tree(batch)
+    address = inputs["obs"]["proprio"].data_ptr()
+    copy_tree(inputs, {"obs": {"proprio": torch.full((4, 2), 7.0)}, "actions": torch.ones(4, 1)})
+    assert inputs["obs"]["proprio"].data_ptr() == address and inputs["obs"]["proprio"].eq(7).all()
+    assert batch["obs"]["proprio"].eq(1).all()  # the clone owns its storage
+    with pytest.raises(ValueError, match=r"changed shape: \(4, 1\) -> \(3, 1\)"):
+        copy_tree(inputs, {"obs": {"proprio": torch.ones(4, 2)}, "actions": torch.ones(3, 1)})
+
+
+@pytest.mark.gpu
+@needs_cuda
+@pytest.mark.parametrize("kl_adaptive", [False, True])
+def test_graphed_updates_train_as_eager_ones(kl_adaptive):
+    device = torch.device("cuda")
+    flags = [f"ppo.kl_adaptive={str(kl_adaptive).lower()}", "ppo.lr=1e-3"]
+    eager, graphed = learner(device, flags), learner(device, [*flags, "ppo.cuda_graph=true"])
+    for seed in range(3):  # the first update captures, the later ones replay
+        fill(eager, device, seed)
+        fill(graphed, device, seed)
+        eager_out, graphed_out = eager.update(), graphed.update()
+        for name, value in eager_out.items():
+            assert graphed_out[name] == pytest.approx(value, rel=1e-4, abs=1e-6), name
+        for a, b in zip(eager.model.parameters(), graphed.model.parameters(), strict=True):
+            torch.testing.assert_close(b, a, rtol=1e-4, atol=1e-6)
+    assert graphed.lr == pytest.approx(eager.lr)
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_graphed_minibatch_steps_never_wait_for_the_device():
+    device = torch.device("cuda")
+    alg = learner(device, ["ppo.cuda_graph=true"])
+    fill(alg, device, 0)
+    alg.update()  # captures
+    fill(alg, device, 1)
+    batches = list(alg.storage.minibatches(alg.config.minibatches, alg.generator))
+    torch.cuda.set_sync_debug_mode("error")
+    try:
+        for batch in batches:
+            alg._graphed(batch)
+    finally:
+        torch.cuda.set_sync_debug_mode(0)
+    assert all(torch.isfinite(p).all() for p in alg.model.parameters())
