@@ -155,7 +155,8 @@ class PPO:
                     metrics = self._graphed(batch)  # its tensors are overwritten by the next minibatch
                 else:
                     metrics = self._minibatch_step(batch, [(aux, aux_batches[aux.name][i]) for aux in active])
-                epoch_kl.append(metrics["ppo/approx_kl"].clone())
+                if c.kl_adaptive:  # a copy: a graphed step overwrites its outputs at the next minibatch
+                    epoch_kl.append(metrics["ppo/approx_kl"].clone())
                 for name, value in metrics.items():
                     sums[name] = sums.get(name, 0.0) + value
                     counts[name] = counts.get(name, 0) + 1
