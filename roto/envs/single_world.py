@@ -3,17 +3,19 @@
 ``RotoEnv.step`` is written for B worlds on any device: some ninety small torch ops a step, each
 costing microseconds of dispatch whatever the batch size, so with one world the ops, not the
 physics, set the pace of ``gymnasium.make("roto/...")``. ``SingleWorldStep`` runs the same step
-for a one-world env on the CPU backend: the task's own rule (torch, written once for every batch
-size) on tensors that share memory with the physics state, and numpy for everything around it
-(action to joint targets, the physics call, observation frame and stack, reward and episode sums,
-terminations). The observation formulas are the env's own (``proprio_parts``), and episode ends
-go through the env's own reset. It reads and writes the env's state, so ``RotoEnv.step``,
-``reset`` and ``state_dict`` stay valid between fast steps, and its trajectories are
-bit-identical to ``RotoEnv.step``'s, the reference (tests/envs/test_single_world.py).
+for a one-world env on the CPU backend in numpy: the task's own rule (written once for torch and
+numpy, ``roto.tasks.arrays``) on numpy views of the task state and of the physics state, and
+numpy for everything around it (action to joint targets, the physics call, observation frame and
+stack, reward and episode sums, terminations). The observation formulas are the env's own
+(``proprio_parts``), and episode ends go through the env's own reset. It reads and writes the
+env's state, so ``RotoEnv.step``, ``reset`` and ``state_dict`` stay valid between fast steps,
+and its trajectories are bit-identical to ``RotoEnv.step``'s, the reference
+(tests/envs/test_single_world.py).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import operator
 from typing import Any
@@ -61,6 +63,23 @@ class _Reader:
         return self._view if self._view is not None else self._source[..., self._index]
 
 
+class _Views:
+    """numpy views of torch tensors the env may replace between steps, one per named slot, made
+    again only when the slot holds another tensor (``Tensor.numpy()`` costs a microsecond or two)."""
+
+    def __init__(self) -> None:
+        self._slots: dict[str, tuple[torch.Tensor, np.ndarray]] = {}
+
+    def of(self, slot: str, tensor: torch.Tensor) -> np.ndarray:
+        """A numpy array sharing ``tensor``'s memory."""
+        cached = self._slots.get(slot)
+        if cached is not None and cached[0] is tensor:
+            return cached[1]
+        view = tensor.numpy()
+        self._slots[slot] = (tensor, view)
+        return view
+
+
 class SingleWorldStep:
     """``RotoEnv.step`` of a one-world CPU env, for a numpy action, with numpy results.
 
@@ -84,11 +103,9 @@ class SingleWorldStep:
         self._act_qpos = _Reader(idx.act_qpos, qpos)
         self._ball_force = _Reader(idx.ball_force, sensors)
         self._tactile_force = _Reader(idx.tactile_force, now)
-        ball_pos, ball_vel = _Reader(idx.ball_pos, qpos).read(), _Reader(idx.ball_vel, qvel).read()
-        self._ball_pos, self._ball_vel = ball_pos, ball_vel
-        # the task reads the balls through tensors that share the state's memory (ball centres and
-        # velocities are evenly spaced columns, so these are views, made once)
-        self._ball_pos_t, self._ball_vel_t = torch.from_numpy(ball_pos), torch.from_numpy(ball_vel)
+        # ball centres and velocities are evenly spaced columns of the state: views, made once
+        self._ball_pos, self._ball_vel = _Reader(idx.ball_pos, qpos).read(), _Reader(idx.ball_vel, qvel).read()
+        self._task_fields = tuple(field.name for field in dataclasses.fields(env.task_state))
         self._obs_lo, self._obs_hi = idx.obs_lo.numpy(), idx.obs_hi.numpy()
         self._ctrl_lo = idx.ctrl_lo.numpy()[None]
         self._ctrl_span = (idx.ctrl_hi - idx.ctrl_lo).numpy()[None]
@@ -98,6 +115,7 @@ class SingleWorldStep:
         self._threshold = config.tactile_threshold
         self._num_actions = env.num_actions
         self._done = torch.ones(1, dtype=torch.bool)
+        self._views = _Views()
 
     def step(self, action: Any) -> SingleStep:
         """One control step from ``action`` (a float array of num_actions values)."""
@@ -106,42 +124,66 @@ class SingleWorldStep:
         unusual = array.dtype.kind != "f" or array.size != self._num_actions or not np.isfinite(array).all()
         if env._needs_reset or unusual:
             return self._reference_step(array)  # raises the env's own error
-        row = array.reshape(1, -1)
-        clamped = np.minimum(np.maximum(row.astype(np.float64), -1.0), 1.0)
-        target = self._ctrl_lo + (clamped + 1.0) * 0.5 * self._ctrl_span
-        if self._alpha != 1.0:
-            target = self._alpha * target + (1.0 - self._alpha) * env._target.numpy()
-        last_action = row.astype(np.float32)
-        env._target = torch.from_numpy(target)
-        env._last_action = torch.from_numpy(last_action)
-
+        target, last_action = self._set_action(array.reshape(1, -1))
         diverged = bool(env.backend.step_array(target)[0])
-        contact = (self._ball_force.read() > self._threshold).any(axis=1)
-        inputs = TaskInputs(self._ball_pos_t, self._ball_vel_t, torch.from_numpy(contact))
-        result = env.task.step(env.task_state, inputs)
-        terms = {name: value.item() for name, value in result.reward_terms.items()}
+        terms, terminated = self._task_step()
         reward = 0.0 if diverged else functools.reduce(operator.add, terms.values())
-        length = env._episode.length.numpy()
+        length = self._views.of("length", env._episode.length)
         length += 1
-        env._episode.ret.numpy()[0] += reward
-        for name, value in result.reward_terms.items():
-            if name in env._term_sums:
-                env._term_sums[name].numpy()[0] += terms[name]
-            else:
-                env._term_sums[name] = value.clone()
-        terminated = diverged or result.terminated.item()
+        self._views.of("return", env._episode.ret)[0] += reward
+        terminated = diverged or terminated
         truncated = not terminated and int(length[0]) >= self._episode_steps
-
-        stack = env._stack._frames
-        obs = {}
-        for name, frame in self._frame(target, last_action).items():
-            frames = np.concatenate([stack[name].numpy()[:, frame.shape[-1] :], frame], axis=1)
-            stack[name] = torch.from_numpy(frames)
-            obs[name] = frames[0].copy()
+        obs = self._push_frame(target, last_action)
         info: dict[str, Any] = {"reward_terms": terms}
         if terminated or truncated:
             info["episode"] = self._reset(truncated, diverged)
         return obs, float(np.float32(reward)), terminated, truncated, info
+
+    def _set_action(self, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The env's joint targets (1, n) float64 and last action (1, n) float32 for action ``row``."""
+        env = self.env
+        clamped = np.minimum(np.maximum(row.astype(np.float64), -1.0), 1.0)
+        target = self._ctrl_lo + (clamped + 1.0) * 0.5 * self._ctrl_span
+        if self._alpha != 1.0:
+            target = self._alpha * target + (1.0 - self._alpha) * self._views.of("target", env._target)
+        last_action = row.astype(np.float32)
+        env._target = torch.from_numpy(target)
+        env._last_action = torch.from_numpy(last_action)
+        return target, last_action
+
+    def _task_step(self) -> tuple[dict[str, float], bool]:
+        """The task's rule on numpy views of its state (written back in place): the reward terms
+        as floats and whether the task ended the episode."""
+        env = self.env
+        state = env.task_state
+        views = {name: self._views.of(f"task/{name}", getattr(state, name)) for name in self._task_fields}
+        numpy_state = type(state)(**views)
+        contact = (self._ball_force.read() > self._threshold).any(axis=1)
+        result = env.task.step(numpy_state, TaskInputs(self._ball_pos, self._ball_vel, contact))
+        for name, view in views.items():
+            value = getattr(numpy_state, name)
+            if value is not view:
+                view[...] = value
+        terms = {}
+        for name, value in result.reward_terms.items():
+            terms[name] = term = float(value[0])
+            if name in env._term_sums:
+                self._views.of(f"sum/{name}", env._term_sums[name])[0] += term
+            else:
+                env._term_sums[name] = torch.from_numpy(value.copy())
+        return terms, bool(result.terminated[0])
+
+    def _push_frame(self, target: np.ndarray, last_action: np.ndarray) -> dict[str, np.ndarray]:
+        """Push this step's frame onto the env's stack in place; the observation (copies)."""
+        stack = self.env._stack._frames
+        obs = {}
+        for name, frame in self._frame(target, last_action).items():
+            frames = self._views.of(f"stack/{name}", stack[name])
+            dim = frame.shape[-1]
+            frames[:, : frames.shape[1] - dim] = frames[:, dim:]
+            frames[:, frames.shape[1] - dim :] = frame
+            obs[name] = frames[0].copy()
+        return obs
 
     def _frame(self, target: np.ndarray, last_action: np.ndarray) -> dict[str, np.ndarray]:
         """This step's observation frame, (1, dim) float32 per group, as ``RotoEnv._frame`` makes it."""
@@ -152,7 +194,7 @@ class SingleWorldStep:
         parts = proprio_parts(
             self._obs_qpos.read(), self._obs_qvel.read(), self._obs_lo, self._obs_hi, target, self._act_qpos.read()
         )
-        frame["proprio"] = _finite(np.concatenate([*parts, last_action.astype(np.float64)], axis=-1).astype(np.float32))
+        frame["proprio"] = _finite(np.concatenate([*parts, last_action], axis=-1).astype(np.float32))
         if "privileged" in groups:
             balls = np.concatenate([self._ball_pos, self._ball_vel], axis=-1).reshape(1, -1).astype(np.float32)
             frame["privileged"] = _finite(balls)

@@ -15,6 +15,7 @@ import numpy as np
 import torch
 
 from roto.sim.backend import SimState
+from roto.sim.one_world import OneWorldStep
 from roto.sim.rollout_threads import RolloutThreads
 
 _FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
@@ -53,6 +54,10 @@ class MujocoCpuBackend:
         self._out_state = np.zeros((num_worlds, substeps, self._nstate))
         self._out_sensor = np.zeros((num_worlds, substeps, model.nsensordata))
         self._time_lag = (substeps - 0.5) * model.opt.timestep
+        # one world steps on a persistent MjData (bit-identical to rollout, a fraction of its
+        # overhead); a step in which MuJoCo reset the world goes through rollout after all
+        self._one_world = OneWorldStep(model, substeps) if num_worlds == 1 else None
+        self._one_sensor_step = OneWorldStep(model, 1)  # sensors_at for a single state
         # the state arrays are only ever written in place, so tensors sharing their memory are
         # made once; a step hands them out again (only `diverged` is fresh each step)
         self._qpos_tensor = torch.from_numpy(self.qpos)
@@ -85,6 +90,9 @@ class MujocoCpuBackend:
     def step_array(self, ctrl: np.ndarray) -> np.ndarray:
         """``step`` for a float64 array ``ctrl`` (B, nu); returns ``diverged`` (B,) bool, the new
         state being in ``state`` and the substeps' sensor values in ``sensordata``."""
+        one_world = self._one_world
+        if one_world is not None and one_world.step(self.state[0], ctrl[0], self._out_sensor[0]):
+            return ~np.isfinite(self.state).all(axis=1)
         self._ctrl[:] = ctrl[:, None, :]
         self._pool.run(self.state, self._ctrl, self._out_state, self._out_sensor, self.substeps)
         expected_time = self.state[:, 0] + self._time_lag
@@ -117,16 +125,20 @@ class MujocoCpuBackend:
         (n, nu); no world changes.
 
         One throw-away physics step from each state computes them (sensors are evaluated on the
-        state a step starts from); its resulting state is discarded.
+        state a step starts from); its resulting state is discarded. A single state (one world's
+        reset) steps on a persistent ``MjData`` (``OneWorldStep``), a batch through ``rollout``.
         """
         n = len(qpos)
         state0 = np.repeat(self._initial_state[None], n, axis=0)
         state0[:, self._qpos0 : self._qpos0 + self.model.nq] = qpos.cpu().to(torch.float64).numpy()
         state0[:, self._qvel0 : self._qvel0 + self.model.nv] = qvel.cpu().to(torch.float64).numpy()
         sensors = np.zeros((n, 1, self.model.nsensordata))
+        control = ctrl.cpu().to(torch.float64).numpy()
+        if n == 1 and self._one_sensor_step.step(state0[0], control[0], sensors[0]):
+            return torch.from_numpy(sensors[:, 0])
         self._pool.run(
             state0,
-            np.ascontiguousarray(ctrl.cpu().to(torch.float64).numpy()[:, None, :]),
+            np.ascontiguousarray(control[:, None, :]),
             np.zeros((n, 1, self._nstate)),
             sensors,
             nstep=1,

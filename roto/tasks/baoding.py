@@ -10,6 +10,7 @@ import torch
 
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
+from roto.tasks.arrays import as_dtype_of, squared_norm, tanh, vector_norm, where
 from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, clear_where, uniform
 
 BALL_MASS = 0.055
@@ -68,7 +69,7 @@ class BaodingState:
 def baoding_rule(
     ball_pos: torch.Tensor, targets: torch.Tensor, swapped: torch.Tensor, latched: torch.Tensor
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-    """One step of the latch-and-swap rule (pure).
+    """One step of the latch-and-swap rule (pure; torch or numpy).
 
     Args:
         ball_pos: (B, 2, 3) ball centres.
@@ -79,10 +80,10 @@ def baoding_rule(
     Returns:
         (distances (B, 2) to the targets used this step, swap (B,) bool, new swapped, new latched)
     """
-    current = torch.where(swapped[:, None, None], targets.flip(0)[None], targets[None])
-    dist = torch.linalg.vector_norm(ball_pos - current, dim=-1)
+    current = where(swapped[:, None, None], targets[[1, 0]][None], targets[None])
+    dist = vector_norm(ball_pos - current)
     latched = latched | (dist < SUCCESS_RADIUS)
-    swap = latched.all(dim=1)
+    swap = latched.all(axis=1)
     swapped = swapped ^ swap
     latched = latched & ~swap[:, None]
     return dist, swap, swapped, latched
@@ -128,12 +129,12 @@ class Baoding:
         pos = inputs.ball_pos
         dist, swap, state.swapped, state.latched = baoding_rule(pos, state.targets, state.swapped, state.latched)
         state.swaps += swap
-        dense = DENSE_SCALE * (1.0 - torch.tanh(dist / DENSE_LENGTH)).sum(dim=1)
-        separation = torch.linalg.vector_norm(pos[:, 0] - pos[:, 1], dim=-1)
-        dropped = (pos[:, :, 2] < -PALM_DROP_LIMIT).any(dim=1)
-        terminated = (separation >= MAX_SEPARATION) | dropped
+        dense = DENSE_SCALE * (1.0 - tanh(dist / DENSE_LENGTH)).sum(axis=1)
+        parted = squared_norm(pos[:, 0] - pos[:, 1]) >= MAX_SEPARATION**2
+        dropped = (pos[:, :, 2] < -PALM_DROP_LIMIT).any(axis=1)
+        terminated = parted | dropped
         return StepResult(
-            reward_terms={"swap": SWAP_REWARD * swap.to(pos.dtype), "distance": dense}, terminated=terminated
+            reward_terms={"swap": SWAP_REWARD * as_dtype_of(swap, pos), "distance": dense}, terminated=terminated
         )
 
     def metrics(self, state: BaodingState) -> dict[str, torch.Tensor]:

@@ -1,7 +1,9 @@
 """The task protocol: what every task provides, written once for every robot.
 
-A task sees the robot only as data (``RobotSpec``) and the simulation only as batched torch
-tensors (``TaskInputs``); it never names a robot and never touches a backend.
+A task sees the robot only as data (``RobotSpec``) and the simulation only as batched arrays
+(``TaskInputs``); it never names a robot and never touches a backend. Its ``step`` runs on torch
+tensors in every batched env and on numpy arrays in the one-world Gymnasium step, with the same
+code: it uses operators, indexing, ``sum``/``any``/``all(axis=...)`` and ``roto.tasks.arrays``.
 """
 
 from __future__ import annotations
@@ -20,7 +22,8 @@ PALM_DROP_LIMIT = 0.2
 
 @dataclass(frozen=True)
 class TaskInputs:
-    """Per-step batched quantities a task reads (task frame: palm centre at the origin, z up).
+    """Per-step batched quantities a task reads (task frame: palm centre at the origin, z up);
+    torch tensors, or numpy arrays in the one-world step.
 
     Attributes:
         ball_pos: (B, n_ball, 3) ball centres, m.
@@ -70,7 +73,8 @@ class Task(Protocol):
         ...
 
     def step(self, state: object, inputs: TaskInputs) -> StepResult:
-        """Advance counters by one control step; return reward terms and terminations."""
+        """Advance counters by one control step; return reward terms and terminations (arrays of
+        the inputs' kind; ``state``'s arrays are of that kind too, updated in place or replaced)."""
         ...
 
     def metrics(self, state: object) -> dict[str, torch.Tensor]:

@@ -8,6 +8,7 @@ import torch
 
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec
+from roto.tasks.arrays import as_dtype_of, squared_norm, where
 from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, clear_where, uniform
 
 BALL = BallSpec(name="ball", radius=0.035, mass=0.030, friction=1.0)
@@ -39,7 +40,7 @@ def bounce_counter(
     steps_without_contact: torch.Tensor,
     min_flight_steps: int = MIN_FLIGHT_STEPS,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """One step of the bounce rule (pure; all inputs and outputs (B,)).
+    """One step of the bounce rule (pure; all inputs and outputs (B,), torch or numpy).
 
     A contact that follows ``min_flight_steps`` or more steps without contact is a valid new
     contact; it is a bounce if contact was lost since the last bounce. The first touchdown after a
@@ -53,7 +54,7 @@ def bounce_counter(
     valid = new_contact & (steps_without_contact >= min_flight_steps)
     bounce = waiting & valid
     waiting = (waiting | lost_contact) & ~bounce
-    steps_without_contact = (steps_without_contact + 1).masked_fill_(contact, 0)
+    steps_without_contact = where(contact, 0, steps_without_contact + 1)
     return bounce, waiting, steps_without_contact
 
 
@@ -94,8 +95,8 @@ class Bounce:
         state.prev_contact = contact
         state.bounces += bounce
         pos = inputs.ball_pos[:, 0]
-        terminated = (pos[:, 2] < -PALM_DROP_LIMIT) | (torch.linalg.vector_norm(pos[:, :2], dim=-1) > HORIZONTAL_LIMIT)
-        return StepResult(reward_terms={"bounce": BOUNCE_REWARD * bounce.to(pos.dtype)}, terminated=terminated)
+        terminated = (pos[:, 2] < -PALM_DROP_LIMIT) | (squared_norm(pos[:, :2]) > HORIZONTAL_LIMIT**2)
+        return StepResult(reward_terms={"bounce": BOUNCE_REWARD * as_dtype_of(bounce, pos)}, terminated=terminated)
 
     def metrics(self, state: BounceState) -> dict[str, torch.Tensor]:
         """Bounces so far this episode."""
