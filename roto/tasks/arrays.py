@@ -26,6 +26,14 @@ def where(condition: Array, x: Array | float, y: Array | float) -> Array:
     return torch.where(condition, x, y)
 
 
+def flip_rows(x: Array) -> Array:
+    """``x`` with its first axis reversed (a view on numpy; no index list, which torch would copy
+    to the device)."""
+    if isinstance(x, np.ndarray):
+        return x[::-1]
+    return x.flip(0)
+
+
 def squared_norm(v: Array) -> Array:
     """Squared Euclidean length over the last axis, (..., 2 or 3) -> (...,), summed in a fixed
     order from elementwise operations (the same bits on numpy and torch, with no torch call)."""

@@ -10,7 +10,7 @@ import torch
 
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
-from roto.tasks.arrays import as_dtype_of, squared_norm, tanh, vector_norm, where
+from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where
 from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, clear_where, uniform
 
 BALL_MASS = 0.055
@@ -80,7 +80,7 @@ def baoding_rule(
     Returns:
         (distances (B, 2) to the targets used this step, swap (B,) bool, new swapped, new latched)
     """
-    current = where(swapped[:, None, None], targets[[1, 0]][None], targets[None])
+    current = where(swapped[:, None, None], flip_rows(targets)[None], targets[None])
     dist = vector_norm(ball_pos - current)
     latched = latched | (dist < SUCCESS_RADIUS)
     swap = latched.all(axis=1)

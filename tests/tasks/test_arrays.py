@@ -8,7 +8,7 @@ import torch
 
 from roto.robots import get_robot
 from roto.tasks import get_task
-from roto.tasks.arrays import as_dtype_of, squared_norm, tanh, vector_norm, where
+from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where
 from roto.tasks.base import TaskInputs
 
 B = 4000
@@ -41,6 +41,8 @@ def test_tanh_where_and_dtype_give_the_same_bits():
     assert_same(where(mask, 0, counts + 1), where(mask_t, 0, counts_t + 1))
     assert_same(where(mask, x, -x), where(mask_t, t, -t))
     assert_same(as_dtype_of(mask, x), as_dtype_of(mask_t, t))
+    assert_same(flip_rows(x), flip_rows(t))
+    np.testing.assert_array_equal(flip_rows(x)[0], x[-1])
 
 
 def random_inputs(task_name, robot, rng):
