@@ -55,7 +55,7 @@ class MujocoCpuBackend:
         self._out_sensor = np.zeros((num_worlds, substeps, model.nsensordata))
         self._time_lag = (substeps - 0.5) * model.opt.timestep
         # one world steps on a persistent MjData (bit-identical to rollout, a fraction of its
-        # overhead); a step in which MuJoCo reset the world goes through rollout after all
+        # overhead); a step that raised a MuJoCo warning goes through rollout after all
         self._one_world = OneWorldStep(model, substeps) if num_worlds == 1 else None
         self._one_sensor_step = OneWorldStep(model, 1)  # sensors_at for a single state
         # the state arrays are only ever written in place, so tensors sharing their memory are
