@@ -139,7 +139,7 @@ def report(task: str, folder: pathlib.Path, meta: dict) -> None:
     table = {"meta": {**meta, "overrides": overrides, "commits": commits}, "results": results}
     (folder.parent / f"{stem}.json").write_text(json.dumps(table, indent=1))
     curves = {variant: [r["evaluations"] for r in runs] for variant, runs in results.items()}
-    title = f"{stem}, commit {', '.join(commits)}"
+    title = f"{stem}\ncommits {', '.join(commits)}"  # two lines: a long commit list fits
     plot_variants(curves, METRIC[task], folder.parent / f"{stem}.png", title=title)
 
 
