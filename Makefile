@@ -19,10 +19,12 @@ $(TEST_STAMP): $(STAMP)
 	$(VENV)/bin/python -m pip install --quiet -e '.[dev,gpu,sb3,rsl_rl,skrl,postgres,wandb]'
 	touch $(TEST_STAMP)
 
-# The quick start: a blind Shadow Bounce agent on the CPU (about 15 minutes on 2 cores).
+# The quick start: a blind Shadow Bounce agent on the CPU (about 15 minutes on 2 cores);
+# `make train SEED=1` trains another seed.
+SEED ?= 0
 train: $(STAMP)
 	$(VENV)/bin/roto train --task bounce --robot shadow --obs blind --num_envs 128 --threads 2 \
-		--torch_threads 2 --steps 2500000 --agent_cfg roto/configs/bounce_cpu_quickstart.yaml
+		--torch_threads 2 --steps 2500000 --seed $(SEED) --agent_cfg roto/configs/bounce_cpu_quickstart.yaml
 
 # ROTO_REQUIRE_WARP / ROTO_REQUIRE_EXTRAS: a missing MuJoCo Warp or learner library fails its
 # tests instead of skipping them
