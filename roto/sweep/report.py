@@ -42,17 +42,25 @@ def export_best(name: str, root: str, storage_url: str | None, out: str | pathli
 
 
 def trials_table(study: optuna.Study) -> str:
-    """A markdown table of every trial: number, state, objective, seed, parameters, why it ended."""
+    """A markdown table of every trial: number, state, objective, seed, the env steps of its last
+    report, its wall minutes (of its last attempt), parameters, why it ended."""
     trials = study.get_trials(deepcopy=False)
     keys = sorted({k for t in trials for k in t.params})
-    head = ["trial", "state", "best eval return", "seed", *keys, "reason"]
+    head = ["trial", "state", "best eval return", "seed", "env steps", "minutes", *keys, "reason"]
     rows = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for t in trials:
         value = f"{t.value:.3f}" if t.value is not None else ""
+        steps = str(max(t.intermediate_values)) if t.intermediate_values else ""
         params = [_short(t.params[k]) if k in t.params else "" for k in keys]
-        cells = [str(t.number), t.state.name.lower(), value, str(t.user_attrs.get("seed", "")), *params]
-        rows.append("| " + " | ".join([*cells, t.user_attrs.get(REASON_ATTR, "")]) + " |")
+        cells = [str(t.number), t.state.name.lower(), value, str(t.user_attrs.get("seed", "")), steps, _minutes(t)]
+        rows.append("| " + " | ".join([*cells, *params, t.user_attrs.get(REASON_ATTR, "")]) + " |")
     return "\n".join(rows)
+
+
+def _minutes(trial: optuna.trial.FrozenTrial) -> str:
+    if trial.datetime_start is None or trial.datetime_complete is None:
+        return ""
+    return f"{(trial.datetime_complete - trial.datetime_start).total_seconds() / 60:.1f}"
 
 
 def importances(study: optuna.Study) -> dict[str, float]:

@@ -61,6 +61,10 @@ def test_a_four_trial_toy_sweep_completes_and_exports_a_loadable_config(tmp_path
 
     table = show(settings.study, settings.root, None)
     assert table.count("| complete |") + table.count("| pruned |") == 4
+    head, *rows = [line.split(" | ") for line in table.splitlines() if line.startswith("| ")]
+    steps = [row[head.index("env steps")] for row in rows]
+    assert steps == [str(max(t.intermediate_values)) for t in study.trials]  # where each trial stopped
+    assert all(float(row[head.index("minutes")]) >= 0 for row in rows)
 
     # rerunning the command continues the study up to its count: nothing left to do
     assert run_worker(settings, env_factory=ToyEnv) == 0
@@ -175,4 +179,5 @@ def test_cli_workers_run_a_study_on_the_real_env_and_show_it(tmp_path, capsys):
     capsys.readouterr()
     assert main(["sweep", "show", "--study", "cli", "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "| trial | state | best eval return | seed | env.action_smoothing | ppo.epochs | ppo.lr | reason |" in out
+    head = "| trial | state | best eval return | seed | env steps | minutes | env.action_smoothing | ppo.epochs |"
+    assert head in out
