@@ -180,4 +180,4 @@ def test_cli_workers_run_a_study_on_the_real_env_and_show_it(tmp_path, capsys):
     assert main(["sweep", "show", "--study", "cli", "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     head = "| trial | state | best eval return | seed | env steps | minutes | env.action_smoothing | ppo.epochs |"
-    assert head in out
+    assert head in out and "| ppo.lr | reason |" in out
