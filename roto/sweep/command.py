@@ -24,7 +24,9 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--robot", default="shadow")
     p.add_argument("--obs", default="blind", help="blind, state or proprio")
     p.add_argument("--agent_cfg", "--agent-cfg", dest="agent_cfg", default=None, help="base agent config")
-    p.add_argument("--space", default="roto2", help="search space: a name in roto/configs/sweep/ (default roto2) or a YAML file")
+    p.add_argument(
+        "--space", default="roto2", help="search space: a name in roto/configs/sweep/ (default roto2) or a YAML file"
+    )
     p.add_argument("--trials", type=int, default=40, help="trials that finish (complete or pruned)")
     p.add_argument("--startup", type=int, default=8, help="random start-up trials (also the pruner's wait)")
     p.add_argument("--steps", type=int, default=2_500_000, help="env steps per trial")
