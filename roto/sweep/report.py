@@ -53,8 +53,22 @@ def trials_table(study: optuna.Study) -> str:
         steps = str(max(t.intermediate_values)) if t.intermediate_values else ""
         params = [_short(t.params[k]) if k in t.params else "" for k in keys]
         cells = [str(t.number), t.state.name.lower(), value, str(t.user_attrs.get("seed", "")), steps, _minutes(t)]
-        rows.append("| " + " | ".join([*cells, *params, t.user_attrs.get(REASON_ATTR, "")]) + " |")
+        rows.append("| " + " | ".join([*cells, *params, _reason(t)]) + " |")
     return "\n".join(rows)
+
+
+def _reason(trial: optuna.trial.FrozenTrial) -> str:
+    """Why the trial ended, and which trial a retry resumes.
+
+    A retry starts with a copy of the failed trial's user attributes, its reason included; that reason
+    is the retry's own only once the retry itself ended pruned or failed.
+    """
+    own = trial.user_attrs.get(REASON_ATTR, "")
+    retried = trial.system_attrs.get("failed_trial")
+    if retried is None:
+        return own
+    ended = trial.state in (TrialState.PRUNED, TrialState.FAIL)
+    return f"retry of trial {retried}" + (f": {own}" if ended and own else "")
 
 
 def _minutes(trial: optuna.trial.FrozenTrial) -> str:

@@ -120,6 +120,9 @@ def test_a_killed_workers_trial_is_failed_and_retried_from_its_checkpoint(tmp_pa
     steps = [r["env_steps"] for r in records]
     assert steps == sorted(set(steps)) and len(records) > killed_at  # resumed, not restarted
     assert len(study.get_trials(states=FINISHED)) == 2
+    table = show(settings.study, settings.root, None)
+    retry_row = next(line for line in table.splitlines() if line.startswith(f"| {retries[0].number} |"))
+    assert "retry of trial 0" in retry_row and "no heartbeat" not in retry_row  # not the first try's reason
 
 
 class NanRewardToyEnv(ToyEnv):
