@@ -44,6 +44,7 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     export = actions.add_parser("export", help="write the best trial as an agent config for roto train --agent_cfg")
     _study_args(export, required=True)
     export.add_argument("--out", required=True, help="YAML file to write")
+    export.add_argument("--trial", type=int, default=None, help="export this complete trial instead of the best")
     export.set_defaults(func=cmd_export)
     show = actions.add_parser("show", help="print the trials table and the parameter importances")
     _study_args(show, required=True)
@@ -88,7 +89,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     """Write the best trial's agent config."""
     from roto.sweep.report import export_best
 
-    print(json.dumps(export_best(args.study, args.root, args.storage, args.out)))
+    print(json.dumps(export_best(args.study, args.root, args.storage, args.out, args.trial)))
     return 0
 
 

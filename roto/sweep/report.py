@@ -15,21 +15,33 @@ from roto.sweep.storage import REASON_ATTR
 from roto.sweep.study import load_existing_study
 
 
-def export_best(name: str, root: str, storage_url: str | None, out: str | pathlib.Path) -> dict:
-    """Write the best complete trial's agent config to ``out`` (YAML ``roto train --agent_cfg`` loads).
+def export_best(
+    name: str, root: str, storage_url: str | None, out: str | pathlib.Path, number: int | None = None
+) -> dict:
+    """Write the best complete trial's agent config (or trial ``number``'s, a complete one) to ``out``
+    (YAML ``roto train --agent_cfg`` loads).
 
     Env parameters of the trial (``env.*``) are not agent settings: the file's header gives the
     ``roto train`` command with them. Returns a summary of the trial.
     """
     study, settings = load_existing_study(name, root, storage_url)
-    if not study.get_trials(deepcopy=False, states=(TrialState.COMPLETE,)):
+    complete = study.get_trials(deepcopy=False, states=(TrialState.COMPLETE,))
+    if not complete:
         raise ValueError(f"study {name!r} has no complete trial yet; nothing to export")
-    best = study.best_trial
+    if number is None:
+        best = study.best_trial
+    else:
+        best = next((t for t in complete if t.number == number), None)
+        if best is None:
+            choices = [t.number for t in complete]
+            raise ValueError(f"trial {number} of study {name!r} is not a complete trial; complete trials: {choices}")
     env_changes, agent_overrides = split_overrides([*settings["overrides"], *as_overrides(best.params)])
     agent = load_agent_config(settings["task"], settings["agent_cfg"], agent_overrides)
     env_args = " ".join(f"env.{k}={v}" for k, v in env_changes.items())
     header = [
-        f"# roto sweep export: study {name!r}, trial {best.number}, best evaluation return {best.value:.3f}"
+        f"# roto sweep export: study {name!r}, trial {best.number}"
+        f" ({'the best' if best.number == study.best_trial.number else 'chosen'}),"
+        f" best evaluation return {best.value:.3f}"
         f" (seed {best.user_attrs.get('seed')}, {settings['steps']} env steps)",
         f"# base config: {settings['agent_cfg'] or settings['task'] + ' (default)'}; search space: {settings['space']}",
         f"# train with: roto train --task {settings['task']} --robot {settings['robot']} --obs {settings['obs']}"

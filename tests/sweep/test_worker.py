@@ -58,6 +58,12 @@ def test_a_four_trial_toy_sweep_completes_and_exports_a_loadable_config(tmp_path
     assert agent.ppo.lr == best.params["ppo.lr"] and agent.ppo.epochs == best.params["ppo.epochs"]
     assert agent.network.encoder == (16,) and agent.ppo.rollouts == 4  # the study's fixed overrides too
     assert f"env.action_smoothing={best.params['env.action_smoothing']}" in out.read_text()
+    other = next(t for t in study.get_trials(states=(TrialState.COMPLETE,)) if t.number != best.number)
+    export_best(settings.study, settings.root, None, out, other.number)  # a chosen trial instead of the best
+    assert load_agent_config("bounce", out).ppo.lr == other.params["ppo.lr"]
+    assert f"trial {other.number} (chosen)" in out.read_text()
+    with pytest.raises(ValueError, match=r"trial 99 .* is not a complete trial; complete trials: \["):
+        export_best(settings.study, settings.root, None, out, 99)
 
     table = show(settings.study, settings.root, None)
     assert table.count("| complete |") + table.count("| pruned |") == 4
