@@ -41,7 +41,7 @@ with at most 292 = 16 x 128 / 7 sequences per update, about one pass over the ro
 
 VARIANTS = {
     "bounce": {
-        "config": "bounce_cpu_quickstart",
+        "config": "bounce_cpu",
         "base": ["ppo.entropy_coef=0.004"],
         "ppo": [],
         "forward_dynamics": [f"ssl.forward_dynamics={{{FD}}}"],

@@ -37,7 +37,7 @@ VARIANTS = {
 def measure(overrides: list[str], args: argparse.Namespace, run_dir: str) -> dict[str, float]:
     """Median per-update timings of a short run with ``overrides``."""
     env = EnvConfig(task="bounce", robot="shadow", num_envs=args.num_envs, threads=args.threads, seed=0)
-    agent = load_agent_config("bounce", "bounce_cpu_quickstart", [*overrides, "run.eval_every=100000"])
+    agent = load_agent_config("bounce", "bounce_cpu", [*overrides, "run.eval_every=100000"])
     steps = agent.ppo.rollouts * args.num_envs * args.updates
     trainer = Trainer(TrainSettings(env=env, total_steps=steps), agent, run_dir, tensorboard=False)
     trainer.train(progress=False)

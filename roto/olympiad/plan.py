@@ -8,7 +8,7 @@ A plan is a YAML file::
     threads: 2
     variants:               # name -> per task: agent config (a file or packaged name; null or
       ppo:                  #   left out: the task's default) and overrides
-        bounce: {agent_cfg: bounce_cpu_quickstart, overrides: [ppo.entropy_coef=0.004]}
+        bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004]}
         baoding: {overrides: [ppo.epochs=4]}
     grids:                  # the cells: the union of these products
       - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0, 1]}
