@@ -82,7 +82,8 @@ def plot_variants(
                 continue
             position = np.array([[r[x] for r in c[:length]] for c in curves]).mean(axis=0)
             values = np.array([[r[f"{metric}_mean"] for r in c[:length]] for c in curves])
-            (line,) = ax.plot(position, values.mean(axis=0), label=f"{variant} ({len(curves)} seeds)")
+            seeds = f"{len(curves)} seed" + ("" if len(curves) == 1 else "s")
+            (line,) = ax.plot(position, values.mean(axis=0), label=f"{variant} ({seeds})")
             ax.fill_between(position, values.min(axis=0), values.max(axis=0), color=line.get_color(), alpha=0.15)
         ax.set_xlabel({"env_steps": "env steps", "train_wall_s": "training wall time (s)"}.get(x, x))
         ax.set_ylabel(f"evaluation {metric} (mean over seeds)")
