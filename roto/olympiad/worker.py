@@ -2,12 +2,13 @@
 
 Each cell is a trial enqueued in the study ``olympiad-<plan>`` (the journal in ``<root>/<plan>``
 or a database, as for sweeps, ``roto.sweep.storage``), its name in the trial's ``cell`` user
-attribute. A worker enqueues every cell that has neither a summary nor a live trial, then asks the
-study for waiting trials until none is left. A worker that dies leaves its trial without a
+attribute. A worker enqueues every cell that has neither a summary nor a live trial, then claims
+waiting trials until none is left. A worker that dies leaves its trial without a
 heartbeat; the next worker to look fails it and enqueues a retry, which continues the cell's run
-from its latest checkpoint. Should a cell be enqueued twice (workers starting at once), the trial
-with the higher number sees the other running or complete and ends as a duplicate: no cell trains
-twice.
+from its latest checkpoint and is claimed before any fresh cell (so interrupted cells finish
+first, and a partial grid is as complete as it can be). Should a cell be enqueued twice (workers
+starting at once), the trial with the higher number sees the other running or complete and ends
+as a duplicate: no cell trains twice.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from collections.abc import Callable
 from typing import Any
 
 import optuna
+from optuna.exceptions import UpdateFinishedTrialError
 from optuna.trial import TrialState
 
 from roto.envs.roto_env import RotoEnv
@@ -26,6 +28,8 @@ from roto.sweep.claims import run_claimed, tell_failed
 from roto.sweep.storage import fail_stale_trials, find_study, open_storage
 
 CELL_ATTR = "cell"
+RETRY_OF = "failed_trial"
+"""System attribute of a retry: the number of the failed trial it continues (Optuna's retry callback)."""
 LIVE = (TrialState.COMPLETE, TrialState.RUNNING, TrialState.WAITING)
 
 
@@ -65,6 +69,22 @@ def is_duplicate(study: optuna.Study, number: int, cell: str) -> bool:
     return any(t.number < number or t.state == TrialState.COMPLETE for t in others)
 
 
+def claim_next(study: optuna.Study, storage: optuna.storages.BaseStorage) -> optuna.Trial | None:
+    """Claim a waiting trial, retries before fresh cells and then by number; None when none waits.
+
+    As ``optuna.Study.ask`` claims one, but in this order: setting a waiting trial running is
+    atomic in every storage, so two workers never claim the same trial.
+    """
+    waiting = study.get_trials(deepcopy=False, states=(TrialState.WAITING,))
+    for trial in sorted(waiting, key=lambda t: (RETRY_OF not in t.system_attrs, t.number)):
+        try:
+            if storage.set_trial_state_values(trial._trial_id, TrialState.RUNNING):
+                return optuna.Trial(study, trial._trial_id)
+        except UpdateFinishedTrialError:  # another worker claimed and finished it meanwhile
+            continue
+    return None
+
+
 def run_olympiad_worker(
     plan: Plan,
     root: str = "runs/olympiad",
@@ -82,12 +102,12 @@ def run_olympiad_worker(
     finished = 0
     while True:
         fail_stale_trials(study, storage, grace=4 * heartbeat)
-        if not study.get_trials(deepcopy=False, states=(TrialState.WAITING,)):
+        trial = claim_next(study, storage)
+        if trial is None:
             return finished
-        trial = study.ask()
         name = trial.user_attrs.get(CELL_ATTR)
-        if name not in cells:  # another worker took the last waiting cell: this is a fresh, empty trial
-            tell_failed(study, trial, "surplus: no cell was waiting")
+        if name not in cells:
+            tell_failed(study, trial, f"unknown cell {name!r}: not in plan {plan.name!r}")
             continue
         if is_duplicate(study, trial.number, name):
             tell_failed(study, trial, f"duplicate: another trial has cell {name}")
