@@ -26,7 +26,16 @@ from roto.eval.episodes import first_episodes
 from roto.registry import make
 from roto.scripted import SCRIPTS, ScriptedBounce
 
-POLICIES = ("mid", "hold", "hold+0.3", "noise", "scripted", "scripted+0.3", "scripted+1")
+POLICIES = {
+    "mid": ("mid", 0.0),
+    "hold": ("hold", 0.0),
+    "hold+0.3": ("hold", 0.3),
+    "noise": ("mid", 1.0),
+    "scripted": ("scripted", 0.0),
+    "scripted+0.3": ("scripted", 0.3),
+    "scripted+1": ("scripted", 1.0),
+}
+"""Policy name -> (base policy, std of the Gaussian noise added to its actions)."""
 
 
 def noisy(act: Callable[[dict], torch.Tensor], std: float, generator: torch.Generator) -> Callable:
@@ -46,14 +55,12 @@ def run_policy(robot: str, policy: str, envs: int, seed: int) -> dict[str, float
     obs, _ = env.reset()
     generator = torch.Generator().manual_seed(seed)
     scripted = ScriptedBounce(env, SCRIPTS[robot])
-    name, _, std = policy.partition("+")
+    name, noise_std = POLICIES[policy]
     base: Callable[[dict], torch.Tensor] = {
         "mid": lambda o: torch.zeros(envs, env.num_actions),
         "hold": lambda o: env.hold_action().expand(envs, -1),
-        "noise": lambda o: torch.zeros(envs, env.num_actions),
         "scripted": scripted,
     }[name]
-    noise_std = 1.0 if name == "noise" else float(std or 0.0)
     act = noisy(base, noise_std, generator) if noise_std else base
     result = first_episodes(env, act, obs, 1, on_done=scripted.reset)
     return {"length": float(result["l"].mean()), "bounces": float(result["bounces"].mean())}

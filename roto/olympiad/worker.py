@@ -25,11 +25,9 @@ from roto.envs.roto_env import RotoEnv
 from roto.olympiad.cell import code_commit, run_cell, summary_path
 from roto.olympiad.plan import Cell, Plan
 from roto.sweep.claims import run_claimed, tell_failed
-from roto.sweep.storage import fail_stale_trials, find_study, open_storage
+from roto.sweep.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage
 
 CELL_ATTR = "cell"
-RETRY_OF = "failed_trial"
-"""System attribute of a retry: the number of the failed trial it continues (Optuna's retry callback)."""
 LIVE = (TrialState.COMPLETE, TrialState.RUNNING, TrialState.WAITING)
 
 
@@ -76,7 +74,7 @@ def claim_next(study: optuna.Study, storage: optuna.storages.BaseStorage) -> opt
     atomic in every storage, so two workers never claim the same trial.
     """
     waiting = study.get_trials(deepcopy=False, states=(TrialState.WAITING,))
-    for trial in sorted(waiting, key=lambda t: (RETRY_OF not in t.system_attrs, t.number)):
+    for trial in sorted(waiting, key=lambda t: (RETRY_OF_ATTR not in t.system_attrs, t.number)):
         try:
             if storage.set_trial_state_values(trial._trial_id, TrialState.RUNNING):
                 return optuna.Trial(study, trial._trial_id)

@@ -11,7 +11,7 @@ from optuna.trial import TrialState
 from roto.rl.config import load_agent_config, to_dict
 from roto.rl.overrides import split_overrides
 from roto.sweep.space import as_overrides
-from roto.sweep.storage import REASON_ATTR
+from roto.sweep.storage import REASON_ATTR, RETRY_OF_ATTR
 from roto.sweep.study import load_existing_study
 
 
@@ -76,7 +76,7 @@ def _reason(trial: optuna.trial.FrozenTrial) -> str:
     is the retry's own only once the retry itself ended pruned or failed.
     """
     own = trial.user_attrs.get(REASON_ATTR, "")
-    retried = trial.system_attrs.get("failed_trial")
+    retried = trial.system_attrs.get(RETRY_OF_ATTR)
     if retried is None:
         return own
     ended = trial.state in (TrialState.PRUNED, TrialState.FAIL)

@@ -30,6 +30,8 @@ from optuna.trial import TrialState
 JOURNAL_NAME = "journal.log"
 HEARTBEAT_ATTR = "roto:heartbeat"
 REASON_ATTR = "reason"
+RETRY_OF_ATTR = "failed_trial"
+"""System attribute of a retry (written by Optuna's retry callback): the number of the first try."""
 MAX_RETRY = 3
 """Retries of one trial after its worker died (then it stays failed)."""
 
@@ -37,7 +39,7 @@ with warnings.catch_warnings():  # Optuna marks the callback experimental; roto 
     warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
     enqueue_retry = RetryHeartbeatStaleTrialCallback(max_retry=MAX_RETRY)
 """``enqueue_retry(study, failed_trial)``: a waiting copy of the trial, its system attribute
-``failed_trial`` naming the first try."""
+``RETRY_OF_ATTR`` naming the first try."""
 
 
 def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.storages.BaseStorage:

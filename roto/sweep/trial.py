@@ -26,6 +26,7 @@ from roto.rl.overrides import apply_env_overrides, split_overrides
 from roto.rl.runner import CHECKPOINT_DIR, Trainer
 from roto.rl.settings import TrainSettings
 from roto.sweep.space import SearchSpace, as_overrides
+from roto.sweep.storage import RETRY_OF_ATTR
 from roto.sweep.study import SweepSettings, trial_seed
 
 
@@ -83,7 +84,7 @@ def run_trial(
     ``system_attrs``: the trial's system attributes (a retry names the trial it retries there).
     """
     params = space.suggest(trial)
-    retried = system_attrs.get("failed_trial")  # the retry callback's record of the first try
+    retried = system_attrs.get(RETRY_OF_ATTR)  # the retry callback's record of the first try
     number = trial.number if retried is None else int(retried)
     run_dir = run_dir_of(settings, number)
     seed = trial_seed(settings.study, number)

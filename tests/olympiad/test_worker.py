@@ -78,6 +78,22 @@ def test_a_killed_workers_cell_is_resumed_from_its_checkpoint(tmp_path):
     assert steps == sorted(set(steps)) and len(steps) > killed_at and steps[-1] == plan.steps  # resumed
 
 
+def test_a_waiting_cell_no_longer_in_the_plan_is_failed_with_its_name(tmp_path):
+    plan_path = write_toy_plan(tmp_path, seeds=(0,))
+    plan, root = load_plan(str(plan_path)), tmp_path / "runs"
+    results = root / plan.name / "results"
+    results.mkdir(parents=True)
+    for cell in plan.cells:  # every cell of the plan is done; a cell of an older plan still waits
+        (results / f"{cell.name}.json").write_text("{}")
+    study = optuna.create_study(study_name=study_name(plan), storage=open_storage(root / plan.name))
+    study.enqueue_trial({}, user_attrs={CELL_ATTR: "bounce-ghost-blind-ppo-seed0"})
+
+    assert toy_worker(plan_path, root) == 0
+    (ghost,) = load_study(root, plan).trials
+    assert ghost.state == TrialState.FAIL
+    assert ghost.user_attrs[REASON_ATTR] == "unknown cell 'bounce-ghost-blind-ppo-seed0': not in plan 'toy'"
+
+
 def test_cli_olympiad_with_two_workers_on_the_real_env_then_results(tmp_path, capsys):
     from roto.cli import main
     from tests.olympiad.toy_plan import TINY
