@@ -31,6 +31,7 @@ from roto.envs.observations import (
     tactile_frame,
 )
 from roto.envs.selections import Selected, Selections
+from roto.envs.spaces import BoundedBox
 from roto.envs.start_pool import StartPool, draw_valid_starts
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
@@ -120,7 +121,7 @@ class RotoEnv:
                 for name, size in self.frame_sizes.items()
             }
         )
-        self.action_space = gym.spaces.Box(-1.0, 1.0, (self.num_actions,), np.float32)
+        self.action_space = BoundedBox(-1.0, 1.0, (self.num_actions,), np.float32)
 
     # ------------------------------------------------------------------ public API
 

@@ -1,7 +1,9 @@
+import gymnasium
 import numpy as np
 import pytest
 import torch
 
+from roto.envs.spaces import BoundedBox
 from roto.registry import list_envs
 from tests.conftest import make_env
 
@@ -55,3 +57,39 @@ def test_proprio_normalised_positions_are_within_bounds():
     pos = obs["proprio"].reshape(4, 4, -1)[:, -1, :20]
     assert torch.all(pos >= -1.0001) and torch.all(pos <= 1.0001)
     assert np.isfinite(obs["proprio"].numpy()).all()
+
+
+@pytest.mark.parametrize(
+    ("low", "high", "shape"),
+    [
+        (-1.0, 1.0, (20,)),  # roto's action space
+        (-0.3, 2.7, (5,)),
+        (np.array([[-1.0, 0.0], [-3.0, 2.0]]), np.array([[1.0, 5.0], [0.0, 2.5]]), None),  # per-coordinate bounds
+    ],
+)
+def test_bounded_box_samples_what_gymnasium_box_samples(low, high, shape):
+    reference = gymnasium.spaces.Box(low, high, shape, np.float32)
+    box = BoundedBox(low, high, shape, np.float32)
+    assert box == reference
+    reference.seed(7)
+    box.seed(7)
+    for _ in range(200):
+        sample = box.sample()
+        assert sample.dtype == np.float32 and box.contains(sample)
+        np.testing.assert_array_equal(sample, reference.sample())
+
+
+def test_bounded_box_refuses_unbounded_or_integer_boxes_and_masks():
+    with pytest.raises(ValueError, match="finite bounds"):
+        BoundedBox(-np.inf, 1.0, (3,), np.float32)
+    with pytest.raises(ValueError, match="float dtype"):
+        BoundedBox(0, 5, (3,), np.int64)
+    with pytest.raises(gymnasium.error.Error, match="mask"):
+        BoundedBox(-1.0, 1.0, (3,), np.float32).sample(mask=np.ones(3))
+
+
+def test_env_action_space_is_a_bounded_box():
+    env = make_env("bounce", robot="shadow", num_envs=1)
+    assert isinstance(env.action_space, BoundedBox) and isinstance(env.action_space, gymnasium.spaces.Box)
+    assert env.action_space == gymnasium.spaces.Box(-1.0, 1.0, (env.num_actions,), np.float32)
+    env.close()
