@@ -44,8 +44,16 @@ def supports_single_world_step(env: RotoEnv) -> bool:
 
 def _finite(x: np.ndarray) -> np.ndarray:
     """``x`` with NaN and inf set to 0, in place (``nan_to_num(nan=0, posinf=0, neginf=0)``)."""
-    np.copyto(x, 0.0, where=~np.isfinite(x))
+    finite = np.isfinite(x)
+    if not np.logical_and.reduce(finite, axis=None):
+        np.copyto(x, 0.0, where=~finite)
     return x
+
+
+def _all_finite(x: np.ndarray) -> bool:
+    """Whether every value of ``x`` is finite (the ufunc reduction itself: ``ndarray.all`` goes
+    through a Python wrapper that costs more than the check on a few dozen values)."""
+    return bool(np.logical_and.reduce(np.isfinite(x), axis=None))
 
 
 class _Reader:
@@ -106,6 +114,11 @@ class SingleWorldStep:
         # ball centres and velocities are evenly spaced columns of the state: views, made once
         self._ball_pos, self._ball_vel = _Reader(idx.ball_pos, qpos).read(), _Reader(idx.ball_vel, qvel).read()
         self._task_fields = tuple(field.name for field in dataclasses.fields(env.task_state))
+        get_fields = operator.attrgetter(*self._task_fields)  # one field: the value, not a 1-tuple
+        self._task_tensors_of = get_fields if len(self._task_fields) > 1 else lambda state: (get_fields(state),)
+        # the task state's tensors the views below share (none yet)
+        self._task_tensors: tuple[torch.Tensor | None, ...] = (None,) * len(self._task_fields)
+        self._task_views: dict[str, np.ndarray] = {}
         self._obs_lo, self._obs_hi = idx.obs_lo.numpy(), idx.obs_hi.numpy()
         self._ctrl_lo = idx.ctrl_lo.numpy()[None]
         self._ctrl_span = (idx.ctrl_hi - idx.ctrl_lo).numpy()[None]
@@ -115,13 +128,14 @@ class SingleWorldStep:
         self._threshold = config.tactile_threshold
         self._num_actions = env.num_actions
         self._done = torch.ones(1, dtype=torch.bool)
+        self._frame_sizes = env.frame_sizes
         self._views = _Views()
 
     def step(self, action: Any) -> SingleStep:
         """One control step from ``action`` (a float array of num_actions values)."""
         env = self.env
         array = np.asarray(action)
-        unusual = array.dtype.kind != "f" or array.size != self._num_actions or not np.isfinite(array).all()
+        unusual = array.dtype.kind != "f" or array.size != self._num_actions or not _all_finite(array)
         if env._needs_reset or unusual:
             return self._reference_step(array)  # raises the env's own error
         target, last_action = self._set_action(array.reshape(1, -1))
@@ -146,9 +160,10 @@ class SingleWorldStep:
         target = self._ctrl_lo + (clamped + 1.0) * 0.5 * self._ctrl_span
         if self._alpha != 1.0:
             target = self._alpha * target + (1.0 - self._alpha) * self._views.of("target", env._target)
-        last_action = row.astype(np.float32)
-        env._target = torch.from_numpy(target)
-        env._last_action = torch.from_numpy(last_action)
+        # written into the env's own tensors (a new tensor a step costs more than the copy)
+        self._views.of("target", env._target)[...] = target
+        last_action = self._views.of("last_action", env._last_action)
+        last_action[...] = row
         return target, last_action
 
     def _task_step(self) -> tuple[dict[str, float], bool]:
@@ -156,9 +171,13 @@ class SingleWorldStep:
         as floats and whether the task ended the episode."""
         env = self.env
         state = env.task_state
-        views = {name: self._views.of(f"task/{name}", getattr(state, name)) for name in self._task_fields}
+        tensors = self._task_tensors_of(state)
+        if not all(map(operator.is_, tensors, self._task_tensors)):  # the env replaced a state tensor
+            self._task_tensors = tensors
+            self._task_views = {name: t.numpy() for name, t in zip(self._task_fields, tensors, strict=True)}
+        views = self._task_views
         numpy_state = type(state)(**views)
-        contact = (self._ball_force.read() > self._threshold).any(axis=1)
+        contact = np.logical_or.reduce(self._ball_force.read() > self._threshold, axis=1)
         result = env.task.step(numpy_state, TaskInputs(self._ball_pos, self._ball_vel, contact))
         for name, view in views.items():
             value = getattr(numpy_state, name)
@@ -174,31 +193,32 @@ class SingleWorldStep:
         return terms, bool(result.terminated[0])
 
     def _push_frame(self, target: np.ndarray, last_action: np.ndarray) -> dict[str, np.ndarray]:
-        """Push this step's frame onto the env's stack in place; the observation (copies)."""
+        """Push this step's frame onto the env's stack in place (the oldest frame out, this
+        step's frame written straight into the newest slot); the observation (copies)."""
         stack = self.env._stack._frames
         obs = {}
-        for name, frame in self._frame(target, last_action).items():
+        for name in self.env.groups:
             frames = self._views.of(f"stack/{name}", stack[name])
-            dim = frame.shape[-1]
-            frames[:, : frames.shape[1] - dim] = frames[:, dim:]
-            frames[:, frames.shape[1] - dim :] = frame
+            dim = self._frame_sizes[name]
+            frames[:, :-dim] = frames[:, dim:]
+            self._write_frame(name, frames[:, -dim:], target, last_action)
             obs[name] = frames[0].copy()
         return obs
 
-    def _frame(self, target: np.ndarray, last_action: np.ndarray) -> dict[str, np.ndarray]:
-        """This step's observation frame, (1, dim) float32 per group, as ``RotoEnv._frame`` makes it."""
-        groups = self.env.groups
-        frame = {}
-        if "tactile" in groups:
-            frame["tactile"] = (self._tactile_force.read() > self._threshold).astype(np.float32)
-        parts = proprio_parts(
-            self._obs_qpos.read(), self._obs_qvel.read(), self._obs_lo, self._obs_hi, target, self._act_qpos.read()
-        )
-        frame["proprio"] = _finite(np.concatenate([*parts, last_action], axis=-1).astype(np.float32))
-        if "privileged" in groups:
-            balls = np.concatenate([self._ball_pos, self._ball_vel], axis=-1).reshape(1, -1).astype(np.float32)
-            frame["privileged"] = _finite(balls)
-        return {name: frame[name] for name in groups}
+    def _write_frame(self, name: str, out: np.ndarray, target: np.ndarray, last_action: np.ndarray) -> None:
+        """Group ``name``'s part of this step's observation frame into ``out`` (1, dim) float32, as
+        ``RotoEnv._frame`` makes it (each value cast once from float64 to float32, as there)."""
+        if name == "tactile":
+            np.greater(self._tactile_force.read(), self._threshold, out=out)
+        elif name == "proprio":
+            parts = proprio_parts(
+                self._obs_qpos.read(), self._obs_qvel.read(), self._obs_lo, self._obs_hi, target, self._act_qpos.read()
+            )
+            _finite(np.concatenate([*parts, last_action], axis=-1, out=out, casting="same_kind"))
+        else:  # privileged: the balls' centres and velocities
+            balls = np.concatenate([self._ball_pos, self._ball_vel], axis=-1).reshape(1, -1)
+            np.copyto(out, balls, casting="same_kind")
+            _finite(out)
 
     def _reset(self, truncated: bool, diverged: bool) -> dict[str, Any]:
         """Start the next episode with the env's own reset; the ended episode's statistics."""

@@ -92,7 +92,7 @@ class MujocoCpuBackend:
         state being in ``state`` and the substeps' sensor values in ``sensordata``."""
         one_world = self._one_world
         if one_world is not None and one_world.step(self.state[0], ctrl[0], self._out_sensor[0]):
-            return ~np.isfinite(self.state).all(axis=1)
+            return ~np.logical_and.reduce(np.isfinite(self.state), axis=1)
         self._ctrl[:] = ctrl[:, None, :]
         self._pool.run(self.state, self._ctrl, self._out_state, self._out_sensor, self.substeps)
         expected_time = self.state[:, 0] + self._time_lag

@@ -50,7 +50,7 @@ class OneWorldStep:
         for k in range(self.substeps):
             mujoco.mj_step(model, data)
             sensordata[k] = self._sensors
-        if self._warnings.any():
+        if np.count_nonzero(self._warnings):
             return False
         mujoco.mj_getState(model, data, state, _FULL)
         return True

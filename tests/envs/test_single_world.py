@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import torch
 
-from roto.envs.single_world import SingleWorldStep, single_world_result, supports_single_world_step
+from roto.envs.single_world import SingleWorldStep, _finite, single_world_result, supports_single_world_step
 from roto.registry import list_envs, make
 
 
@@ -103,3 +103,11 @@ def test_only_one_cpu_world_is_supported():
     with pytest.raises(ValueError, match="num_envs=2"):
         SingleWorldStep(batched)
     assert supports_single_world_step(make("bounce", robot="shadow", num_envs=1))
+
+
+def test_non_finite_frame_values_become_zero_in_place_as_nan_to_num_makes_them():
+    values = np.array([[1.5, np.nan, np.inf, -np.inf, -2.0]], dtype=np.float32)
+    expected = torch.from_numpy(values.copy()).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0).numpy()
+    assert _finite(values) is values
+    np.testing.assert_array_equal(values, expected)
+    assert _finite(values) is values and values.tolist() == [[1.5, 0.0, 0.0, 0.0, -2.0]]
