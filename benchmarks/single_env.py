@@ -2,7 +2,7 @@
 Gymnasium's own ``benchmark_step`` (random actions, ``action_space.sample()`` included), against
 plain single-thread ``mj_step`` (``roto bench``'s raw figure) on the states that env visited.
 
-    python benchmarks/single_env.py --repeats 5 --out benchmarks/results/single_env.json
+    python benchmarks/single_env.py --repeats 5 --out single_env.json
 
 ``ratio = env steps/s ÷ (raw physics steps/s ÷ substeps)``: 1.0 would mean the env costs nothing
 beyond its physics. The two figures are taken in turn, ``--repeats`` times each, and their
