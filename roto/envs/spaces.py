@@ -18,7 +18,8 @@ import numpy as np
 
 
 class BoundedBox(gym.spaces.Box):
-    """A float ``Box`` with finite bounds on every coordinate."""
+    """A float ``Box`` with finite bounds on every coordinate (read once, at construction, as
+    ``Box`` reads which coordinates are bounded)."""
 
     def __init__(self, low: Any, high: Any, shape: tuple[int, ...] | None = None, dtype: Any = np.float32, **kwargs):
         super().__init__(low, high, shape, dtype, **kwargs)
