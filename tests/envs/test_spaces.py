@@ -64,7 +64,8 @@ def test_proprio_normalised_positions_are_within_bounds():
     [
         (-1.0, 1.0, (20,)),  # roto's action space
         (-0.3, 2.7, (5,)),
-        (np.array([[-1.0, 0.0], [-3.0, 2.0]]), np.array([[1.0, 5.0], [0.0, 2.5]]), None),  # per-coordinate bounds
+        # per-coordinate bounds
+        (np.array([[-1.0, 0.0], [-3.0, 2.0]], np.float32), np.array([[1.0, 5.0], [0.0, 2.5]], np.float32), None),
     ],
 )
 def test_bounded_box_samples_what_gymnasium_box_samples(low, high, shape):
