@@ -76,8 +76,15 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
+    from roto.registry import get_task
+
+    task = get_task(args.task).name
+    if task == "baoding":
+        return _demo_baoding(args)
     from roto.scripted import run_scripted_bounce
 
+    if args.preswap_out is not None:
+        raise ValueError("--preswap_out is for --task baoding (the Bounce script makes no swaps)")
     stats = run_scripted_bounce(
         robot=args.robot,
         num_envs=args.num_envs,
@@ -86,6 +93,28 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         progress=True,
         backend=args.backend,
         device=args.device,
+    )
+    print(json.dumps(stats))
+    return 0
+
+
+def _demo_baoding(args: argparse.Namespace) -> int:
+    import pathlib
+
+    from roto.reference.baoding_controller import run_reference_baoding
+
+    if args.backend != "cpu":
+        raise ValueError(f"backend {args.backend!r}: the Baoding reference controller plans on 'cpu' only")
+    out = pathlib.Path(args.preswap_out) if args.preswap_out else None
+    if out is not None and not out.parent.is_dir():
+        raise FileNotFoundError(f"--preswap_out: directory {str(out.parent)!r} does not exist")
+    stats = run_reference_baoding(
+        robot=args.robot,
+        episodes=args.episodes,
+        seed=args.seed,
+        threads=args.threads,
+        preswap_path=out,
+        progress=True,
     )
     print(json.dumps(stats))
     return 0
@@ -270,9 +299,23 @@ def _add_bench_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def _add_demo_parser(sub: argparse._SubParsersAction) -> None:
-    p_demo = sub.add_parser("demo", help="run the scripted Bounce policy and print its bounces per episode")
+    p_demo = sub.add_parser(
+        "demo",
+        help="run a task's reference controller: the scripted Bounce policy (bounces per episode) or, with "
+        "--task baoding, predictive sampling over the true dynamics (rotations per episode; slow: about a "
+        "minute per episode on 2 threads)",
+    )
     _add_env_args(p_demo, num_envs=8)
-    p_demo.add_argument("--episodes", type=int, default=1, help="episodes per env (default: 1)")
+    p_demo.add_argument(
+        "--episodes", type=int, default=1, help="episodes per env (Baoding: episodes of its one world; default: 1)"
+    )
+    p_demo.add_argument(
+        "--preswap_out",
+        "--preswap-out",
+        dest="preswap_out",
+        default=None,
+        help="Baoding: write the states recorded just before each swap to this .npz",
+    )
     p_demo.set_defaults(func=_cmd_demo)
 
 

@@ -10,9 +10,6 @@ from roto.tasks import TASKS, get_task
 if TYPE_CHECKING:
     from roto.envs.roto_env import RotoEnv
 
-ENV_VERSION = 0
-"""Bumped whenever dynamics, rewards, observations or terminations change."""
-
 
 def make(
     task: str,
@@ -51,8 +48,10 @@ def list_envs() -> list[tuple[str, str]]:
 
 
 def gym_id(task: str, robot: str) -> str:
-    """Gymnasium id of a (task, robot) pair, e.g. ``roto/Bounce-Shadow-v0``."""
-    return f"roto/{get_task(task).display_name}-{get_robot(robot).display_name}-v{ENV_VERSION}"
+    """Gymnasium id of a (task, robot) pair, e.g. ``roto/Bounce-Shadow-v0``; the version is the task's
+    (``Task.version``, bumped whenever its dynamics, rewards, observations or terminations change)."""
+    spec = get_task(task)
+    return f"roto/{spec.display_name}-{get_robot(robot).display_name}-v{spec.version}"
 
 
 def register_gymnasium_envs() -> None:

@@ -6,7 +6,7 @@ from roto.cli import main
 def test_list_prints_every_pair_with_sizes(capsys):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
-    assert "roto/Bounce-Shadow-v0" in out and "roto/Baoding-Shadow-v0" in out
+    assert "roto/Bounce-Shadow-v0" in out and "roto/Baoding-Shadow-v1" in out
     assert "97" in out and "388" in out
     assert "frame (taxels)" in out and "143" in out  # Shadow: 97 + 46 taxels
 

@@ -31,6 +31,7 @@ class SceneIndices:
     ball_force: Columns  # (n_ball,) sensordata index of each ball-hand normal force
     taxels: Columns  # (n_taxels,) sensordata index of each taxel's normal force (empty without taxels)
     self_contact: Columns  # (2,) sensordata indices of the hand's self-contact (found, distance m)
+    ball_clearance: Columns  # (n_ball, 2) sensordata indices of each ball's deepest contact (found, distance m)
     default_qpos: torch.Tensor  # (1, nq), the balls' quaternions at identity
     coupled_driven: Columns
     coupled_driver: Columns
@@ -74,6 +75,7 @@ class SceneIndices:
             ball_force=c(layout.ball_contact_sensor + 1),
             taxels=c(layout.taxel_sensor),
             self_contact=c([layout.self_contact_sensor, layout.self_contact_sensor + 1]),
+            ball_clearance=c(layout.ball_clearance_sensor[:, None] + np.arange(2)),
             default_qpos=t(default, f64)[None],
             coupled_driven=c(driven),
             coupled_driver=c(driver),

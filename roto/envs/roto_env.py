@@ -32,7 +32,7 @@ from roto.envs.observations import (
 )
 from roto.envs.selections import Selected, Selections
 from roto.envs.spaces import BoundedBox
-from roto.envs.start_pool import StartPool, draw_valid_starts
+from roto.envs.start_pool import MAX_BALL_START_PENETRATION, StartPool, draw_valid_starts
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
 from roto.sim.backend import make_backend
@@ -122,6 +122,7 @@ class RotoEnv:
             }
         )
         self.action_space = BoundedBox(-1.0, 1.0, (self.num_actions,), np.float32)
+        self._check_balls_start_clear()
 
     # ------------------------------------------------------------------ public API
 
@@ -360,18 +361,34 @@ class RotoEnv:
         """n physically valid episode starts (``roto.envs.start_pool.draw_valid_starts``)."""
         return draw_valid_starts(self._draw_candidates, n, self.robot.name)
 
-    def _draw_candidates(self, n: int) -> dict[str, torch.Tensor]:
+    def _check_balls_start_clear(self, probes: int = 16) -> None:
+        """Refuse a task whose balls start inside the hand or each other on every probe start (drawn
+        from a generator of its own, so the env's random stream is untouched)."""
+        generator = torch.Generator(device=self.device)
+        generator.manual_seed(0)
+        depth = self._draw_candidates(probes, generator)["ball_penetration"]
+        if bool((depth > MAX_BALL_START_PENETRATION).all()):
+            raise ValueError(
+                f"robot {self.robot.name!r}, task {self.task.name!r}: the balls start {1000 * float(depth.min()):.1f}"
+                f"-{1000 * float(depth.max()):.1f} mm deep inside the hand or each other in all {probes} probe "
+                f"starts (at most {1000 * MAX_BALL_START_PENETRATION:.0f} mm allowed); move the balls' start"
+            )
+
+    def _draw_candidates(self, n: int, generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
         """n candidate starts: hand at the default pose + noise, the task's balls placed, zero velocity;
-        their qpos (n, nq), joint targets (n, n_act), first frame ("frame/<group>", (n, dim)) and the
-        depth (m) of the hand's deepest self-contact ("penetration", (n,))."""
+        their qpos (n, nq), joint targets (n, n_act), first frame ("frame/<group>", (n, dim)), the
+        depth (m) of the hand's deepest self-contact ("penetration", (n,)) and of the balls' deepest
+        contact with the hand or each other ("ball_penetration", (n,)). Random draws come from
+        ``generator`` (default: the env's)."""
+        generator = generator or self._generator
         idx = self._idx
         qpos = idx.default_qpos.expand(n, -1).clone()
-        noise = uniform(self._generator, (n, self.num_actions), self.config.reset_joint_noise, self.device)
+        noise = uniform(generator, (n, self.num_actions), self.config.reset_joint_noise, self.device)
         idx.act_qpos.put(qpos, torch.clamp(idx.act_qpos.take(qpos) + noise, idx.ctrl_lo, idx.ctrl_hi))
         idx.coupled_driven.put(
             qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
         )
-        ball_pos = self.task.initial_ball_positions(self.task_state, n, self._generator)
+        ball_pos = self.task.initial_ball_positions(self.task_state, n, generator)
         idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))  # the default pose holds the balls' identity quaternions
         qvel = qpos.new_zeros(n, self.model.nv)
         target = idx.act_qpos.take(qpos).clone()
@@ -382,8 +399,16 @@ class RotoEnv:
         frame = self._frame(selected, inputs, target, last_action)
         found, dist = idx.self_contact.take(sensors).unbind(-1)
         penetration = torch.where(found > 0, (-dist).clamp(min=0.0), 0.0)
+        found, dist = idx.ball_clearance.take(sensors).unbind(-1)  # (n, n_ball) each
+        ball_penetration = torch.where(found > 0, (-dist).clamp(min=0.0), 0.0).amax(dim=1)
         frames = {f"frame/{name}": value for name, value in frame.items()}
-        return {"qpos": qpos, "target": target, **frames, "penetration": penetration}
+        return {
+            "qpos": qpos,
+            "target": target,
+            **frames,
+            "penetration": penetration,
+            "ball_penetration": ball_penetration,
+        }
 
     def _episode_info(self, truncated: torch.Tensor) -> dict[str, torch.Tensor]:
         info = {

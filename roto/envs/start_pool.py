@@ -31,31 +31,38 @@ MAX_START_PENETRATION = 0.0
 """Deepest self-contact (m) of the hand allowed at an episode start: none at all, so no touch bit
 is on at a start (the ball starts in the air)."""
 
+MAX_BALL_START_PENETRATION = 0.001
+"""Deepest contact (m) of a ball, with the hand or another ball, allowed at an episode start: the
+1 mm the hand's own contacts meet in a resting grasp (a ball dropped from above starts clear)."""
+
 MAX_DRAW_ROUNDS = 100
 """Rounds of drawing replacements for rejected starts before giving up."""
 
 
 def draw_valid_starts(draw: Callable[[int], Starts], n: int, robot: str) -> Starts:
-    """n starts whose hand has no self-contact deeper than ``MAX_START_PENETRATION``.
+    """n starts whose hand has no self-contact deeper than ``MAX_START_PENETRATION`` and whose balls
+    are nowhere deeper than ``MAX_BALL_START_PENETRATION`` inside the hand or each other.
 
     ``draw(k)`` returns k candidates with a "penetration" row each (m, the hand's deepest
-    self-contact); rejected ones are replaced by fresh candidates, round after round, in draw order.
-    Joint noise can press neighbouring fingers into each other; such a start would begin with the
-    fingers kicked apart and touch bits on with nothing touched. Returns the starts without
-    "penetration".
+    self-contact) and a "ball_penetration" row (m, the balls' deepest contact); rejected ones are
+    replaced by fresh candidates, round after round, in draw order. Joint noise can press
+    neighbouring fingers into each other, or a finger into a ball; such a start would begin with
+    the parts kicked apart and touch bits on with nothing touched. Returns the starts without the
+    two depths.
     """
     kept: list[Starts] = []
     missing = n
     for _ in range(MAX_DRAW_ROUNDS):
         candidates = draw(missing)
         valid = candidates.pop("penetration") <= MAX_START_PENETRATION
+        valid &= candidates.pop("ball_penetration") <= MAX_BALL_START_PENETRATION
         kept.append({name: rows[valid] for name, rows in candidates.items()})
         missing -= int(valid.sum())
         if missing == 0:
             return {name: torch.cat([part[name] for part in kept]) for name in kept[0]}
     raise RuntimeError(
-        f"robot {robot!r}: {missing} of {n} episode starts still had the hand pressed into itself after "
-        f"{MAX_DRAW_ROUNDS} rounds of redrawing; lower reset_joint_noise"
+        f"robot {robot!r}: {missing} of {n} episode starts still had the hand pressed into itself or into a "
+        f"ball after {MAX_DRAW_ROUNDS} rounds of redrawing; lower reset_joint_noise or move the task's balls"
     )
 
 

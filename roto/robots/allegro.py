@@ -16,7 +16,9 @@ import math
 import mujoco
 import numpy as np
 
-from roto.robots.spec import Gains, RobotSpec
+from roto.robots.spec import Gains, RobotSpec, side_by_side
+
+_BAODING_RADIUS = 0.5 * 2.0 * 0.0254
 
 # Finger chain (index, middle, ring): base (abduction about z) -> proximal -> medial -> distal -> tip,
 # each joint this far along z from the previous one (m).
@@ -191,6 +193,8 @@ ALLEGRO = RobotSpec(
     knuckle_bodies=("ff_base", "mf_base", "rf_base"),
     tip_bodies=("ff_tip", "mf_tip", "rf_tip"),
     thumb_tip="th_tip",
-    baoding_ball_radius=0.5 * 2.0 * 0.0254,
-    baoding_targets=((0.0597, 0.0223, 0.0205), (0.0578, -0.0284, 0.0216)),  # calibrate_targets(ALLEGRO)
+    baoding_ball_radius=_BAODING_RADIUS,
+    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's Allegro variant, the
+    # second target beside it, 2r + 5 mm away across the fingers (towards the index finger)
+    baoding_targets=side_by_side((0.0589, 0.0, 0.0217), _BAODING_RADIUS, (0.0, -1.0, 0.0)),
 )

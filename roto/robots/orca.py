@@ -14,7 +14,9 @@ import pathlib
 import mujoco
 import numpy as np
 
-from roto.robots.spec import Gains, RobotSpec
+from roto.robots.spec import Gains, RobotSpec, diagonal_stack
+
+_BAODING_RADIUS = 0.5 * 1.5 * 0.0254
 
 _FINGERS = ("index", "middle", "ring", "pinky")
 
@@ -110,8 +112,12 @@ ORCA = RobotSpec(
     knuckle_bodies=tuple(_j(f"{f}_mp") for f in _FINGERS),
     tip_bodies=tuple(_j(f"{f}_ip") for f in _FINGERS),
     thumb_tip=_j("thumb_dp"),
-    baoding_ball_radius=0.5 * 1.5 * 0.0254,
-    baoding_targets=((0.0691, 0.035, -0.0199), (0.0777, -0.002, -0.0229)),  # calibrate_targets(ORCA)
+    baoding_ball_radius=_BAODING_RADIUS,
+    # T_palm: where the dropped ball a comes to rest (rest_after_drop); the stack δ·(1, 1, 1) above it,
+    # not roto's ORCA variant δ·(-1, 1, 1), where holding still swaps about once an episode (docs/tasks.md)
+    baoding_targets=diagonal_stack((0.0777, -0.0021, -0.0229), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
+    # above the finger pocket: dropped above the palm centre, 9 of 12 pairs fell off (docs/tasks.md)
+    baoding_drop_centre=(0.073, 0.017, 0.09),
     # The bounding boxes are fuller than the meshes: the palm box reaches the fingers' first links.
     excluded_contacts=(
         *((_j("palm"), _j(f"{f}_{link}")) for f in (*_FINGERS, "thumb") for link in ("pp", "ip")),

@@ -12,7 +12,9 @@ import pathlib
 
 import mujoco
 
-from roto.robots.spec import Gains, RobotSpec
+from roto.robots.spec import Gains, RobotSpec, diagonal_stack
+
+_BAODING_RADIUS = 0.5 * 1.5 * 0.0254
 
 _FINGERS = ("ff", "mf", "rf", "lf", "th")
 
@@ -86,6 +88,7 @@ SHADOW = RobotSpec(
     knuckle_bodies=tuple(_j(f"{f}knuckle") for f in ("ff", "mf", "rf", "lf")),
     tip_bodies=tuple(_j(f"{f}distal") for f in ("ff", "mf", "rf", "lf")),
     thumb_tip=_j("thdistal"),
-    baoding_ball_radius=0.5 * 1.5 * 0.0254,
-    baoding_targets=((0.0243, 0.0073, 0.0028), (0.0577, -0.0079, -0.0066)),  # calibrate_targets(SHADOW)
+    baoding_ball_radius=_BAODING_RADIUS,
+    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack δ·(1, 1, 1) above it
+    baoding_targets=diagonal_stack((0.0577, -0.0079, -0.0066), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
 )

@@ -15,7 +15,9 @@ import mujoco
 import numpy as np
 
 from roto.robots.shadow import load_shadow_spec
-from roto.robots.spec import Gains, RobotSpec
+from roto.robots.spec import Gains, RobotSpec, diagonal_stack
+
+_BAODING_RADIUS = 0.5 * 1.2 * 0.0254
 
 WRIST_BENT_BACK = math.radians(40.0)
 """The Lite's fixed wrist extension (rad); WRJ0 < 0 is extension in the gym model."""
@@ -123,7 +125,10 @@ SHADOW_LITE = RobotSpec(
     knuckle_bodies=tuple(_j(f"{f}knuckle") for f in _FINGERS),
     tip_bodies=tuple(_j(f"{f}distal") for f in _FINGERS),
     thumb_tip=_j("thdistal"),
-    baoding_ball_radius=0.5 * 1.2 * 0.0254,
-    baoding_targets=((0.0265, -0.0173, 0.0098), (0.0559, -0.0106, 0.0068)),  # calibrate_targets(SHADOW_LITE)
+    baoding_ball_radius=_BAODING_RADIUS,
+    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack δ·(1, 1, 1) above it
+    baoding_targets=diagonal_stack((0.0559, -0.0106, 0.0068), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
+    # above the finger pocket: dropped above the palm centre, 12 of 12 pairs fell off (docs/tasks.md)
+    baoding_drop_centre=(0.041, -0.014, 0.09),
     excluded_contacts=tuple((_j("palm"), _j(b)) for b in ("ffknuckle", "mfknuckle", "rfknuckle", "thbase")),
 )

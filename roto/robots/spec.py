@@ -40,8 +40,10 @@ class RobotSpec:
         tip_bodies: distal finger bodies, used to find the finger direction.
         thumb_tip: the thumb's distal body (with ``tip_bodies`` and the palm: where taxels lie).
         baoding_ball_radius: Baoding ball radius for this hand (m).
-        baoding_targets: T_a and T_b (task frame, m), calibrated where two balls really rest in
-            the default pose (``roto.tasks.baoding.calibrate_targets``; a test re-checks them).
+        baoding_targets: T_a and T_b (task frame, m): roto's diagonal stack (``diagonal_stack``) or
+            side-by-side pair (``side_by_side``) placed in this hand's cupped pose (docs/tasks.md).
+        baoding_drop_centre: midpoint (task frame, m) of the two Baoding balls when they are
+            dropped at an episode start (each 2 cm from it along the fingers).
         coupled_joints: driven joint -> (driving joint, ratio): the model couples them (tendon or
             equality); resets set driven = ratio * driving so no coupling starts violated.
         excluded_contacts: body pairs whose contacts are filtered out.
@@ -66,6 +68,7 @@ class RobotSpec:
     thumb_tip: str
     baoding_ball_radius: float
     baoding_targets: tuple[tuple[float, float, float], tuple[float, float, float]]
+    baoding_drop_centre: tuple[float, float, float] = (0.0, 0.0, 0.09)
     coupled_joints: Mapping[str, tuple[str, float]] = field(default_factory=dict)
     excluded_contacts: tuple[tuple[str, str], ...] = field(default=())
     palm_tilt: tuple[float, float] = (0.0, 0.0)
@@ -81,3 +84,25 @@ class RobotSpec:
     def num_actions(self) -> int:
         """Action dimension (one per actuated joint)."""
         return len(self.actuated_joints)
+
+
+Point = tuple[float, float, float]
+
+DIAGONAL_CLEARANCE = 0.001
+"""roto's diagonal stack: each coordinate of the raised target is 2r/√3 + 1 mm from T_palm."""
+SIDE_BY_SIDE_GAP = 0.005
+"""roto's side-by-side targets (its Allegro): centres 2r + 5 mm apart."""
+
+
+def diagonal_stack(palm: Point, radius: float, signs: Point = (1.0, 1.0, 1.0)) -> tuple[Point, Point]:
+    """roto's Baoding targets: T_palm and T_palm + δ·signs, δ = 2r/√3 + 1 mm (the balls' centres
+    2r + √3 mm apart, one raised above the other when ``signs[2]`` is 1)."""
+    delta = 2.0 * radius / 3.0**0.5 + DIAGONAL_CLEARANCE
+    return tuple(palm), tuple(p + delta * s for p, s in zip(palm, signs, strict=True))
+
+
+def side_by_side(palm: Point, radius: float, direction: Point) -> tuple[Point, Point]:
+    """Targets T_palm and T_palm + (2r + 5 mm)·direction/|direction| (roto's Allegro placement)."""
+    norm = sum(d * d for d in direction) ** 0.5
+    spacing = 2.0 * radius + SIDE_BY_SIDE_GAP
+    return tuple(palm), tuple(p + spacing * d / norm for p, d in zip(palm, direction, strict=True))

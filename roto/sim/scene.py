@@ -9,7 +9,10 @@ The model holds, besides the hand, one free-floating sphere per ball and two kin
 * one per ball: ``body1 = ball``, ``subtree2 = hand root`` (hand contact only, not ball-ball);
 * one for the hand's self-contacts: ``subtree1 = subtree2 = hand root``, data ``found dist``
   reduced to the deepest contact, which the env uses to keep interpenetrating poses out of
-  episode starts.
+  episode starts;
+* one per ball for its clearance: ``body1 = ball``, any partner (the hand or another ball), data
+  ``found dist`` reduced to the deepest contact, which keeps balls started inside the hand or
+  inside each other out of episode starts.
 
 With taxel touch, a ``touch`` sensor on each taxel box over the fingertip pads and the palm
 (``roto.sim.taxels``).
@@ -68,6 +71,7 @@ class SceneLayout:
     taxel_sensor: np.ndarray  # [n_taxels] sensordata address of each taxel's touch sensor (none without taxels)
     self_contact_sensor: int  # sensordata address of the hand's self-contact sensor (found, dist)
     ball_contact_sensor: np.ndarray  # [n_ball] sensordata address of each ball-hand contact sensor
+    ball_clearance_sensor: np.ndarray  # [n_ball] sensordata address of each ball's deepest contact (found, dist)
     default_qpos: np.ndarray  # [nq] hand at its default pose, balls at the origin (placed by the task)
     hand_qpos: np.ndarray  # [n_hand_q] qpos addresses of every hand joint
 
@@ -86,12 +90,17 @@ def _add_contact_sensor(
     sensor.intprm = np.array([_FOUND | _FORCE, reduce, 1] + [0] * (len(sensor.intprm) - 3))
 
 
-def _add_self_contact_sensor(spec: mujoco.MjSpec, root: str) -> None:
+def _add_deepest_contact_sensor(spec: mujoco.MjSpec, name: str, body: str, subtree: str | None = None) -> None:
+    """(found, dist) of the deepest contact of ``body`` (or of the subtree ``subtree`` against itself)."""
     sensor = spec.add_sensor()
-    sensor.name = "hand_self_contact"
+    sensor.name = name
     sensor.type = mujoco.mjtSensor.mjSENS_CONTACT
-    sensor.objtype = sensor.reftype = mujoco.mjtObj.mjOBJ_XBODY
-    sensor.objname = sensor.refname = root
+    if subtree is None:
+        sensor.objtype = mujoco.mjtObj.mjOBJ_BODY
+        sensor.objname = body
+    else:
+        sensor.objtype = sensor.reftype = mujoco.mjtObj.mjOBJ_XBODY
+        sensor.objname = sensor.refname = subtree
     sensor.intprm = np.array([_FOUND | _DIST, _REDUCE_MINDIST, 1] + [0] * (len(sensor.intprm) - 3))
 
 
@@ -123,7 +132,9 @@ def build_scene_spec(robot: RobotSpec, balls: tuple[BallSpec, ...], touch: str =
         _add_contact_sensor(spec, f"touch_{link}", link, reduce=reduce)
     for ball in balls:
         _add_contact_sensor(spec, f"hand_contact_{ball.name}", ball.name, subtree2=robot.root_body)
-    _add_self_contact_sensor(spec, robot.root_body)
+    _add_deepest_contact_sensor(spec, "hand_self_contact", robot.root_body, subtree=robot.root_body)
+    for ball in balls:
+        _add_deepest_contact_sensor(spec, f"clearance_{ball.name}", ball.name)
     if touch == "taxels":
         for k, taxel in enumerate(hand_taxels(robot)):
             _add_taxel(spec, f"taxel_{k}", taxel)
@@ -200,6 +211,7 @@ def scene_layout(model: mujoco.MjModel, robot: RobotSpec, balls: tuple[BallSpec,
         tactile_sensor=np.array([sensor_adr(f"touch_{link}") for link in robot.tactile_links], dtype=np.int64),
         ball_contact_sensor=np.array([sensor_adr(f"hand_contact_{b.name}") for b in balls], dtype=np.int64),
         self_contact_sensor=sensor_adr("hand_self_contact"),
+        ball_clearance_sensor=np.array([sensor_adr(f"clearance_{b.name}") for b in balls], dtype=np.int64),
         taxel_sensor=np.array(
             [model.sensor_adr[i] for i in range(model.nsensor) if model.sensor(i).name.startswith("taxel_")],
             dtype=np.int64,

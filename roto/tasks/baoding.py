@@ -24,8 +24,10 @@ MAX_SEPARATION = 0.15
 """Balls this far apart end the episode (m)."""
 RESET_NOISE = 0.005
 """Half-width of the shared uniform offset of both balls at reset (m)."""
-CALIBRATION_DIAGONAL = (1.0 / np.sqrt(2.0), -1.0 / np.sqrt(2.0), 0.0)
-"""Palm diagonal (towards the fingers and the thumb) along which the second ball is placed."""
+DROP_SPACING = 0.04
+"""The balls are dropped side by side this far apart along the fingers (x), ball a nearer the tips
+(m), or a diameter + ``DROP_GAP`` apart where that is more (the Allegro's 2-inch balls)."""
+DROP_GAP = 0.001
 
 
 def baoding_balls(radius: float) -> tuple[BallSpec, ...]:
@@ -36,24 +38,48 @@ def baoding_balls(radius: float) -> tuple[BallSpec, ...]:
     )
 
 
-def calibrate_targets(robot: RobotSpec, settle_steps: int = 900, substeps: int = 4) -> np.ndarray:
-    """Where two balls really rest in ``robot``'s default pose: targets (2, 3) in the task frame.
+def drop_spacing(radius: float) -> float:
+    """Distance (m) between the dropped balls' centres: roto's 4 cm, or 2r + 1 mm if more."""
+    return max(DROP_SPACING, 2.0 * radius + DROP_GAP)
 
-    Ball a is dropped just above the palm centre, ball b one diameter + 1.7 mm away along the
-    palm diagonal ``CALIBRATION_DIAGONAL``; the hand holds its default pose and both settle for
-    ``settle_steps`` control steps. T_a and T_b are where they come to rest.
-    """
+
+def drop_positions(centre: torch.Tensor, radius: float) -> torch.Tensor:
+    """(2, 3): where the balls are dropped from, side by side along x about ``centre`` (3,)."""
+    half = torch.tensor([0.5 * drop_spacing(radius), 0.0, 0.0], dtype=centre.dtype, device=centre.device)
+    return torch.stack([centre + half, centre - half])
+
+
+def rest_after_drop(robot: RobotSpec, settle_steps: int = 600, substeps: int = 4) -> np.ndarray:
+    """Where the two balls come to rest (2, 3), task frame, when dropped from the robot's drop
+    positions (no offset) onto the hand holding its default pose for ``settle_steps`` control
+    steps. Ball a's resting place is the hand's T_palm (docs/tasks.md)."""
     radius = robot.baoding_ball_radius
     model, layout = build_scene(robot, baoding_balls(radius))
     data = mujoco.MjData(model)
     data.qpos[:] = layout.default_qpos
-    start_a = np.array([0.0, 0.0, radius + 0.005])
-    start_b = start_a + (2 * radius + 0.0017) * np.array(CALIBRATION_DIAGONAL)
-    for adr, start in zip(layout.ball_qpos, (start_a, start_b), strict=True):
+    drop = drop_positions(torch.tensor(robot.baoding_drop_centre, dtype=torch.float64), radius).numpy()
+    for adr, start in zip(layout.ball_qpos, drop, strict=True):
         data.qpos[adr : adr + 3] = start
     data.ctrl[:] = layout.default_qpos[layout.act_qpos]
     mujoco.mj_step(model, data, nstep=settle_steps * substeps)
     return np.stack([data.qpos[adr : adr + 3].copy() for adr in layout.ball_qpos])
+
+
+def check_setup(robot: RobotSpec) -> None:
+    """Refuse Baoding targets closer together than 2r: balls on them would overlap.
+
+    Raises:
+        ValueError naming the hand and the distances. (Whether the drop starts the balls clear of
+        the hand is checked where the env is made, and on every start: ``roto.envs.start_pool``.)
+    """
+    radius = robot.baoding_ball_radius
+    t_a, t_b = np.asarray(robot.baoding_targets, dtype=np.float64)
+    gap = float(np.linalg.norm(t_a - t_b))
+    if gap < 2.0 * radius:
+        raise ValueError(
+            f"robot {robot.name!r}: Baoding targets {gap * 1000:.1f} mm apart, closer than two ball radii "
+            f"({2000 * radius:.1f} mm): balls on them would overlap"
+        )
 
 
 @dataclass
@@ -61,6 +87,7 @@ class BaodingState:
     """Per-env task state."""
 
     targets: torch.Tensor  # (2, 3) T_a, T_b, shared by all envs
+    drop: torch.Tensor  # (2, 3) where ball a and ball b are dropped from, before the shared offset
     swapped: torch.Tensor  # (B,) bool: ball a aims at T_b and ball b at T_a
     latched: torch.Tensor  # (B, 2) bool: ball i has reached its current target
     swaps: torch.Tensor  # (B,) int64
@@ -94,6 +121,9 @@ class Baoding:
 
     name = "baoding"
     display_name = "Baoding"
+    version = 1
+    """v1: balls dropped from above, roto's diagonal (or side-by-side) targets; v0 started the balls
+    on targets where they rest, partly inside the hand."""
     metric_names = ("swaps", "rotations")
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
@@ -101,10 +131,13 @@ class Baoding:
         return baoding_balls(robot.baoding_ball_radius)
 
     def init_state(self, robot: RobotSpec, num_envs: int, device: torch.device) -> BaodingState:
-        """Targets from the robot's calibration; latches clear."""
+        """Targets and drop from the robot record; latches clear."""
+        check_setup(robot)
         targets = torch.tensor(robot.baoding_targets, dtype=torch.float64, device=device)
+        centre = torch.tensor(robot.baoding_drop_centre, dtype=torch.float64, device=device)
         return BaodingState(
             targets=targets,
+            drop=drop_positions(centre, robot.baoding_ball_radius),
             swapped=torch.zeros(num_envs, dtype=torch.bool, device=device),
             latched=torch.zeros(num_envs, 2, dtype=torch.bool, device=device),
             swaps=torch.zeros(num_envs, dtype=torch.int64, device=device),
@@ -117,12 +150,10 @@ class Baoding:
             clear_where(latch, mask)
 
     def initial_ball_positions(self, state: BaodingState, n: int, generator: torch.Generator) -> torch.Tensor:
-        """(n, 2, 3): ball a on T_b and ball b on T_a, plus one shared U(±5 mm)³ offset.
-
-        Started on their own targets, both balls would latch at once and the first swap would be free.
-        """
+        """(n, 2, 3): both balls in the air above the hand, side by side along the fingers, plus one
+        shared U(±5 mm)³ offset; they fall into the hand (roto's drop)."""
         offset = uniform(generator, (n, 1, 3), RESET_NOISE, state.targets.device)
-        return state.targets.flip(0)[None] + offset
+        return state.drop[None] + offset
 
     def step(self, state: BaodingState, inputs: TaskInputs) -> StepResult:
         """Latch, swap (+10), dense shaping; end when the balls part or drop."""

@@ -54,6 +54,8 @@ class Task(Protocol):
 
     name: str
     display_name: str
+    version: int
+    """The Gymnasium id's version, bumped whenever dynamics, rewards, observations or terminations change."""
     metric_names: tuple[str, ...]
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:

@@ -63,6 +63,7 @@ class Bounce:
 
     name = "bounce"
     display_name = "Bounce"
+    version = 0
     metric_names = ("bounces",)
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:

@@ -76,3 +76,15 @@ def test_step_never_modifies_the_callers_action(env):
     for _ in range(40):  # long enough for terminations and resets
         env.step(action)
     assert torch.all(action == 0.5)
+
+
+def test_a_baoding_drop_inside_the_hand_is_refused_when_the_env_is_made(monkeypatch):
+    """Balls 'dropped' from the palm surface start half inside it: the env refuses, naming the hand and depth."""
+    import dataclasses
+
+    import roto.robots as robots
+
+    sunk = dataclasses.replace(robots.ROBOTS["shadow"], baoding_drop_centre=(0.0, 0.0, 0.0))
+    monkeypatch.setitem(robots.ROBOTS, "shadow", sunk)
+    with pytest.raises(ValueError, match=r"robot 'shadow', task 'baoding': the balls start [0-9.]+-[0-9.]+ mm deep"):
+        roto.make("baoding", robot="shadow")

@@ -5,7 +5,6 @@ import pytest
 from roto.robots import get_robot
 from roto.robots.mjspec_tools import palm_frame
 from roto.sim.scene import BallSpec, build_scene
-from roto.tasks.baoding import calibrate_targets
 
 SHADOW = get_robot("shadow")
 
@@ -52,10 +51,12 @@ def test_no_tactile_bit_in_the_default_pose_without_objects():
     assert np.all(data.sensordata[layout.tactile_sensor] == 0)
 
 
-def test_baoding_targets_match_a_fresh_calibration():
-    targets = calibrate_targets(SHADOW)
-    np.testing.assert_allclose(targets, np.array(SHADOW.baoding_targets), atol=2e-3)
-    assert np.linalg.norm(targets[0] - targets[1]) == pytest.approx(2 * SHADOW.baoding_ball_radius, abs=2e-3)
+def test_baoding_targets_are_roto_s_diagonal_stack():
+    """T_diag = T_palm + δ·(1, 1, 1), δ = 2r/√3 + 1 mm: one target 23 mm above the other."""
+    t_palm, t_diag = np.array(SHADOW.baoding_targets)
+    delta = 2 * SHADOW.baoding_ball_radius / np.sqrt(3) + 0.001
+    np.testing.assert_allclose(t_diag - t_palm, delta * np.ones(3), atol=1e-12)
+    assert t_diag[2] - t_palm[2] == pytest.approx(0.0230, abs=1e-4)
 
 
 def test_unknown_robot_names_the_valid_ones():

@@ -17,6 +17,8 @@ from roto.tasks.baoding import baoding_balls
 _FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
 _CTRL = mujoco.mjtState.mjSTATE_CTRL.value
 SUBSTEPS = 4
+REST = ((0.0577, -0.0079, -0.0066), (0.0243, 0.0073, 0.0028))
+"""Where the Shadow's two dropped Baoding balls come to rest (``roto.tasks.baoding.rest_after_drop``)."""
 
 
 @pytest.fixture(scope="module")
@@ -26,8 +28,8 @@ def scene():
     model, layout = build_scene(robot, baoding_balls(robot.baoding_ball_radius))
     data = mujoco.MjData(model)
     data.qpos[:] = layout.default_qpos
-    for adr, target in zip(layout.ball_qpos, robot.baoding_targets, strict=True):
-        data.qpos[adr : adr + 3] = np.asarray(target) + np.array([0.0, 0.0, 0.004])
+    for adr, rest in zip(layout.ball_qpos, REST, strict=True):
+        data.qpos[adr : adr + 3] = np.asarray(rest) + np.array([0.0, 0.0, 0.004])
     state = np.zeros(mujoco.mj_stateSize(model, _FULL))
     mujoco.mj_getState(model, data, state, _FULL)
     return model, layout, state

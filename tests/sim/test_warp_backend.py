@@ -15,6 +15,7 @@ from roto.robots import ROBOTS, get_robot
 from roto.sim.backend import make_backend
 from roto.sim.scene import BallSpec, build_scene
 from roto.tasks import TASKS
+from roto.tasks.baoding import rest_after_drop
 from tests.conftest import require_warp
 
 QPOS_TOLERANCE = 1e-3
@@ -115,6 +116,9 @@ def test_sensors_at_more_states_than_worlds_match_the_cpu_backend_and_change_no_
             env.step(env.hold_action().expand(2, -1))
     starts = envs[0]._draw_starts(5)  # 5 states on 2 worlds: chunks of 2, 2 and 1 on Warp
     qpos, target = starts["qpos"], starts["target"]
+    rest = torch.from_numpy(rest_after_drop(envs[0].robot))  # (2, 3) the balls landed in the hand
+    for adr, ball in zip(envs[0].layout.ball_qpos, rest, strict=True):
+        qpos[:, adr : adr + 3] = ball
     qvel = torch.zeros(5, envs[0].model.nv, dtype=torch.float64)
     before = physics(envs[1])
     sensors = [env.backend.sensors_at(qpos, qvel, target).to(torch.float64) for env in envs]
@@ -225,7 +229,7 @@ def test_a_too_small_contact_capacity_is_an_error_not_silence():
     env = roto.make("baoding", robot="allegro", num_envs=2, backend="warp", nconmax=1, njmax=8)
     env.reset()
     with pytest.raises(RuntimeError, match=r"ran out of capacity for .*nconmax=1"):
-        for _ in range(3):
+        for _ in range(30):  # the dropped balls land within about 10 steps
             env.step(torch.zeros(2, env.num_actions))
 
 

@@ -1,7 +1,10 @@
+import dataclasses
+
+import pytest
 import torch
 
 from roto.robots import get_robot
-from roto.tasks.baoding import Baoding, baoding_rule
+from roto.tasks.baoding import DROP_SPACING, RESET_NOISE, Baoding, baoding_rule, drop_spacing
 from roto.tasks.base import TaskInputs
 
 SHADOW = get_robot("shadow")
@@ -58,18 +61,33 @@ def test_terminations():
     assert task.step(state, _inputs([0, 0, -0.21], [0.03, 0, 0.01])).terminated[0]
 
 
-def test_reset_clears_state_and_places_balls_on_the_other_target():
+def test_reset_clears_state_and_drops_the_balls_side_by_side_from_above():
     task = Baoding()
     state = task.init_state(SHADOW, 2, torch.device("cpu"))
     state.swapped[:] = True
     state.latched[:] = True
     state.swaps[:] = 3
     task.reset(state, torch.tensor([False, True]))
-    pos = task.initial_ball_positions(state, 1, torch.Generator().manual_seed(0))
     assert state.swapped.tolist() == [True, False] and state.swaps.tolist() == [3, 0]
     assert state.latched.tolist() == [[True, True], [False, False]]
-    offset = pos[0] - TARGETS.flip(0)
-    assert torch.all(offset.abs() <= 0.005) and torch.allclose(offset[0], offset[1])
-    # no swap is free: neither ball starts within the success radius of its own target
-    dist, swap, *_ = baoding_rule(pos, TARGETS, torch.tensor([False]), torch.zeros(1, 2, dtype=torch.bool))
-    assert not swap[0] and torch.all(dist > 0.01)
+    pos = task.initial_ball_positions(state, 64, torch.Generator().manual_seed(0))
+    centre = torch.tensor(SHADOW.baoding_drop_centre, dtype=torch.float64)
+    half = torch.tensor([[DROP_SPACING / 2, 0, 0], [-DROP_SPACING / 2, 0, 0]], dtype=torch.float64)
+    offset = pos - (centre + half)
+    assert torch.all(offset.abs() <= RESET_NOISE)
+    torch.testing.assert_close(offset[:, 0], offset[:, 1], atol=1e-15, rtol=0)  # one shared offset
+    assert float(offset.abs().max()) > 0.004  # the offset is drawn, not zero
+    assert torch.all(pos[..., 2] > 0.08)  # 9 cm above the palm: they fall into the hand
+
+
+def test_the_allegro_s_larger_balls_are_dropped_a_diameter_and_1mm_apart():
+    allegro = get_robot("allegro")
+    assert drop_spacing(allegro.baoding_ball_radius) == pytest.approx(2 * 0.0254 + 0.001)
+    assert drop_spacing(SHADOW.baoding_ball_radius) == DROP_SPACING
+
+
+def test_targets_closer_than_two_radii_are_refused_naming_the_hand_and_distances():
+    t_palm = SHADOW.baoding_targets[0]
+    close = dataclasses.replace(SHADOW, baoding_targets=(t_palm, (t_palm[0] + 0.03, t_palm[1], t_palm[2])))
+    with pytest.raises(ValueError, match=r"robot 'shadow': Baoding targets 30\.0 mm apart.*\(38\.1 mm\)"):
+        Baoding().init_state(close, 1, torch.device("cpu"))

@@ -1,9 +1,10 @@
-"""The cupped default pose holds the objects: Bounce's ball and both Baoding balls."""
+"""The cupped default pose holds the objects: Bounce's ball and both dropped Baoding balls."""
 
 import mujoco
 import numpy as np
 import pytest
 
+from roto.reference.hold import run_hold
 from roto.robots import ROBOTS, get_robot
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
@@ -37,12 +38,13 @@ def test_dropped_bounce_ball_comes_to_rest_without_termination(name):
 
 
 @pytest.mark.parametrize("name", sorted(ROBOTS))
-def test_baoding_balls_on_their_targets_stay_within_1cm_for_600_steps(name):
-    robot = get_robot(name)
-    targets = np.array(robot.baoding_targets)
-    trace = _hold(robot, "baoding", [targets[0], targets[1]])
-    deviation = np.linalg.norm(trace - targets[None], axis=-1)
-    assert deviation.max() < 0.01, deviation.max()
+def test_the_hold_pose_catches_the_dropped_baoding_balls_and_never_swaps(name):
+    """16 episodes of the hold policy from the env's own starts (joint noise, dropped balls): the
+    hand keeps the balls through most episodes (over 64 episodes: all on three hands, 61 on the
+    Shadow Lite; docs/tasks.md) and holding alone earns no swap."""
+    stats = run_hold("baoding", name, num_envs=16, seed=0)
+    assert stats["full_length_share"] >= 0.75, stats
+    assert stats["mean_swaps"] == 0.0, stats
 
 
 # Issue thresholds: the Shadow >= 10 bounces per 10 s episode, every other hand >= 5.

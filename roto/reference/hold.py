@@ -1,0 +1,34 @@
+"""The hold policy: every joint held at the default (cupped) pose, the floor any Baoding agent must beat.
+
+It never swaps (the targets are placed so that it cannot); what it scores is the dense reward of
+balls lying where they fell, and how often the hand drops them.
+"""
+
+from __future__ import annotations
+
+import torch
+
+from roto.eval.episodes import first_episodes
+from roto.registry import make
+
+
+def run_hold(
+    task: str = "baoding", robot: str = "shadow", num_envs: int = 64, seed: int = 0, backend: str = "cpu"
+) -> dict[str, float]:
+    """One episode per env of the hold policy from the env's own starts; its return and metrics."""
+    env = make(task, robot=robot, num_envs=num_envs, seed=seed, backend=backend)
+    hold = env.hold_action().expand(num_envs, -1).contiguous()
+    obs, _ = env.reset()
+    result = first_episodes(env, lambda _obs: hold, obs)
+    env.close()
+    stats = {
+        "task": env.task.name,
+        "robot": env.robot.name,
+        "episodes": num_envs,
+        "mean_return": float(result["r"].mean()),
+        "std_return": float(result["r"].std()),
+        "mean_length": float(result["l"].mean()),
+        "full_length_share": float((result["l"] == env.config.episode_steps).to(torch.float64).mean()),
+    }
+    stats.update({f"mean_{name}": float(result[name].mean()) for name in env.task.metric_names})
+    return stats
