@@ -1,6 +1,6 @@
 """The Baoding hold policy on every hand: dense return, swaps, and how often the dropped balls are lost.
 
-    python benchmarks/baoding_hold.py --envs 64 --out benchmarks/results/baoding_reference/hold.json
+python benchmarks/baoding_hold.py --envs 64 --out benchmarks/results/baoding_reference/hold.json
 """
 
 from __future__ import annotations
