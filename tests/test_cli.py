@@ -29,3 +29,15 @@ def test_demo_runs_the_scripted_policy(capsys):
     assert main(["demo", "--num_envs", "2", "--episodes", "1"]) == 0
     stats = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert stats["episodes"] == 2 and stats["mean_bounces"] >= 0
+
+
+def test_baoding_demo_refuses_what_the_reference_controller_cannot_do(capsys, tmp_path):
+    assert main(["demo", "--task", "baoding", "--backend", "warp"]) == 2
+    assert "the Baoding reference controller plans on 'cpu' only" in capsys.readouterr().err
+    missing = tmp_path / "nowhere" / "states.npz"
+    assert main(["demo", "--task", "baoding", "--preswap_out", str(missing)]) == 2
+    assert f"directory {str(missing.parent)!r} does not exist" in capsys.readouterr().err
+    assert main(["demo", "--task", "bounce", "--preswap_out", str(tmp_path / "s.npz")]) == 2
+    assert "--preswap_out is for --task baoding" in capsys.readouterr().err
+    assert main(["demo", "--task", "baoding", "--episodes", "0"]) == 2
+    assert "episodes must be an integer >= 1, got 0" in capsys.readouterr().err
