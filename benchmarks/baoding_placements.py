@@ -4,7 +4,9 @@
 For each candidate: how deep a ball on the second target sits inside the hand at the default pose
 (with ball a on T_palm), the hold policy's return and swaps over 16 episodes (a placement that
 hands out swaps for holding still is no task), and the swaps of one short episode of the reference
-controller (a placement it cannot swap on may be impossible).
+controller (a placement it cannot swap on may be impossible). And where to drop the balls from:
+12 noisy drops above the palm centre and above the hand's chosen drop centre, the hand holding its
+default pose for 10 s, counting the pairs it loses.
 
     python benchmarks/baoding_placements.py --steps 300 --out benchmarks/results/baoding_reference/placements.json
 """
@@ -28,7 +30,8 @@ from roto.reference.hold import run_hold
 from roto.reference.predictive_sampling import PredictiveSampling, SamplingConfig
 from roto.robots.spec import RobotSpec, diagonal_stack, side_by_side
 from roto.sim.scene import build_scene
-from roto.tasks.baoding import baoding_balls
+from roto.tasks.baoding import MAX_SEPARATION, RESET_NOISE, baoding_balls, drop_positions
+from roto.tasks.base import PALM_DROP_LIMIT
 
 
 def candidates(robot: RobotSpec) -> dict[str, tuple]:
@@ -60,6 +63,42 @@ def target_depth(robot: RobotSpec) -> float:
         if (model.geom_bodyid[c.geom1] in balls) != (model.geom_bodyid[c.geom2] in balls)
     ]
     return max([0.0, *depths])
+
+
+def lost_drops(robot: RobotSpec, centre: tuple[float, float, float], drops: int = 12) -> int:
+    """Of ``drops`` pairs dropped about ``centre`` (+ one shared U(±5 mm)³ offset each) onto the hand
+    holding its default pose for 600 control steps, how many end the episode (parted or fallen)."""
+    model, layout = build_scene(robot, baoding_balls(robot.baoding_ball_radius))
+    rng = np.random.default_rng(0)
+    start = drop_positions(torch.tensor(centre, dtype=torch.float64), robot.baoding_ball_radius).numpy()
+    lost = 0
+    for _ in range(drops):
+        data = mujoco.MjData(model)
+        data.qpos[:] = layout.default_qpos
+        offset = rng.uniform(-RESET_NOISE, RESET_NOISE, 3)
+        for adr, ball in zip(layout.ball_qpos, start, strict=True):
+            data.qpos[adr : adr + 3] = ball + offset
+        data.ctrl[:] = layout.default_qpos[layout.act_qpos]
+        for _ in range(600):
+            mujoco.mj_step(model, data, nstep=4)
+            pos = np.array([data.qpos[adr : adr + 3] for adr in layout.ball_qpos])
+            if pos[:, 2].min() < -PALM_DROP_LIMIT or np.linalg.norm(pos[0] - pos[1]) >= MAX_SEPARATION:
+                lost += 1
+                break
+    return lost
+
+
+def drops_row(name: str) -> dict:
+    robot = robots.ROBOTS[name]
+    palm_centre = (0.0, 0.0, robot.baoding_drop_centre[2])
+    row = {
+        "robot": name,
+        "drop_centre": list(robot.baoding_drop_centre),
+        "lost_of_12_at_drop_centre": lost_drops(robot, robot.baoding_drop_centre),
+        "lost_of_12_above_palm_centre": lost_drops(robot, palm_centre),
+    }
+    print(json.dumps(row), flush=True)
+    return row
 
 
 def measure(name: str, steps: int) -> list[dict]:
@@ -102,10 +141,11 @@ def main() -> None:
     parser.add_argument("--out", type=pathlib.Path, default=None)
     args = parser.parse_args()
     torch.set_num_threads(1)
-    rows = [row for name in args.robots for row in measure(name, args.steps)]
+    drops = [drops_row(name) for name in args.robots]
+    placements = [row for name in args.robots for row in measure(name, args.steps)]
     if args.out is not None:
         args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(rows, indent=1) + "\n")
+        args.out.write_text(json.dumps({"drops": drops, "placements": placements}, indent=1) + "\n")
 
 
 if __name__ == "__main__":
