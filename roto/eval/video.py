@@ -84,7 +84,24 @@ class TactileFrameRenderer:
         self.model.site_rgba[self._taxel_sites] = 0.0  # only pressed taxels are drawn
         self.model.site_rgba[self._taxel_sites[pressed]] = TAXEL_RGBA
         self.renderer.update_scene(self.data, camera=self.camera, scene_option=self._option)
+        self._add_markers()
         return self.renderer.render().copy()
+
+    def _add_markers(self) -> None:
+        """Append the task's markers of world 0 (e.g. Baoding's targets) to the scene as spheres."""
+        scene = self.renderer.scene
+        for marker in self.env.task.markers(self.env.task_state):
+            if scene.ngeom >= scene.maxgeom:
+                return
+            mujoco.mjv_initGeom(
+                scene.geoms[scene.ngeom],
+                mujoco.mjtGeom.mjGEOM_SPHERE,
+                np.array([marker.radius, 0.0, 0.0]),
+                marker.pos[0].detach().cpu().numpy().astype(np.float64),
+                np.eye(3).flatten(),
+                np.array(marker.rgba, dtype=np.float32),
+            )
+            scene.ngeom += 1
 
     def _touch(self) -> tuple[np.ndarray, np.ndarray]:
         """(per tactile link its touch value, per taxel whether it is pressed) after ``mj_forward``,

@@ -11,7 +11,7 @@ import torch
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
 from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where
-from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, clear_where, uniform
+from roto.tasks.base import PALM_DROP_LIMIT, Marker, StepResult, TaskInputs, clear_where, uniform
 
 BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
@@ -172,3 +172,11 @@ class Baoding:
         """Swaps and rotations (= swaps / 2) so far this episode."""
         swaps = state.swaps.to(torch.float32)
         return {"swaps": swaps, "rotations": swaps / 2.0}
+
+    def markers(self, state: BaodingState) -> list[Marker]:
+        """Each ball's current target, a translucent sphere of the success radius in the ball's colour."""
+        current = torch.where(state.swapped[:, None, None], state.targets.flip(0)[None], state.targets[None])
+        return [
+            Marker(pos=current[:, i], radius=SUCCESS_RADIUS, rgba=(*ball.rgba[:3], 0.35))
+            for i, ball in enumerate(baoding_balls(0.0))
+        ]

@@ -49,6 +49,21 @@ class StepResult:
     terminated: torch.Tensor
 
 
+@dataclass(frozen=True)
+class Marker:
+    """A point a task wants drawn in pictures and videos (not part of the physics).
+
+    Attributes:
+        pos: (B, 3) position per world, task frame, m.
+        radius: sphere radius, m.
+        rgba: colour.
+    """
+
+    pos: torch.Tensor
+    radius: float
+    rgba: tuple[float, float, float, float]
+
+
 class Task(Protocol):
     """A robot-agnostic task."""
 
@@ -81,6 +96,10 @@ class Task(Protocol):
 
     def metrics(self, state: object) -> dict[str, torch.Tensor]:
         """Episode metrics so far, name -> (B,) float."""
+        ...
+
+    def markers(self, state: object) -> list[Marker]:
+        """What pictures and videos should draw besides the scene (e.g. targets); may be empty."""
         ...
 
 

@@ -9,7 +9,7 @@ import torch
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec
 from roto.tasks.arrays import as_dtype_of, squared_norm, where
-from roto.tasks.base import PALM_DROP_LIMIT, StepResult, TaskInputs, clear_where, uniform
+from roto.tasks.base import PALM_DROP_LIMIT, Marker, StepResult, TaskInputs, clear_where, uniform
 
 BALL = BallSpec(name="ball", radius=0.035, mass=0.030, friction=1.0)
 SPAWN_HEIGHT = 0.10
@@ -102,3 +102,7 @@ class Bounce:
     def metrics(self, state: BounceState) -> dict[str, torch.Tensor]:
         """Bounces so far this episode."""
         return {"bounces": state.bounces.to(torch.float32)}
+
+    def markers(self, state: BounceState) -> list[Marker]:
+        """None: Bounce has no targets."""
+        return []

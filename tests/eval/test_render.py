@@ -66,3 +66,22 @@ def test_render_with_taxel_touch_draws_the_pressed_taxels(tmp_path):
         assert main(args) == 0
         counts[touch] = yellow_pixels(imageio.imread(out))
     assert counts["binary"] < 20 < counts["taxels"]
+
+
+def test_baoding_pictures_draw_each_ball_s_current_target():
+    import roto
+    from roto.eval.video import TactileFrameRenderer
+    from roto.tasks.baoding import SUCCESS_RADIUS
+
+    env = roto.make("baoding", robot="shadow", num_envs=1)
+    env.reset()
+    env.task_state.swapped[0] = True  # ball a now aims at the second target
+    renderer = TactileFrameRenderer(env, 160, 120)
+    renderer.render()
+    scene = renderer.renderer.scene
+    spheres = [scene.geoms[i] for i in range(scene.ngeom)][-2:]
+    targets = env.task_state.targets.numpy()
+    np.testing.assert_allclose([g.pos for g in spheres], targets[::-1], atol=1e-6)
+    assert all(g.size[0] == pytest.approx(SUCCESS_RADIUS) and g.rgba[3] < 1 for g in spheres)
+    renderer.close()
+    env.close()
