@@ -32,23 +32,14 @@ from roto.envs.observations import (
 )
 from roto.envs.selections import Selected, Selections
 from roto.envs.spaces import BoundedBox
-from roto.envs.start_pool import MAX_BALL_START_PENETRATION, StartPool, draw_valid_starts
+from roto.envs.start_pool import StartPool, check_balls_start_clear, contact_depth, draw_valid_starts
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
 from roto.sim.backend import make_backend
-from roto.sim.host_sync import deliberate_host_sync
+from roto.sim.host_sync import deliberate_host_sync, resolve_device
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
 from roto.tasks.base import TaskInputs, uniform
-
-
-def resolve_device(device: str | torch.device) -> torch.device:
-    """``device`` with its index made explicit (``cuda`` -> ``cuda:<current>``), as tensors report it."""
-    device = torch.device(device)
-    if device.type == "cuda" and device.index is None:
-        return torch.device("cuda", torch.cuda.current_device())
-    return device
-
 
 DEVICE_CHECK_EVERY = 16
 """Steps between the host reads of a GPU env (pool of starts, action finiteness)."""
@@ -122,7 +113,8 @@ class RotoEnv:
             }
         )
         self.action_space = BoundedBox(-1.0, 1.0, (self.num_actions,), np.float32)
-        self._check_balls_start_clear()
+        # a task whose balls start inside the hand is refused now, not after rounds of redrawing
+        check_balls_start_clear(self._draw_candidates, self.robot.name, self.task.name, self.device)
 
     # ------------------------------------------------------------------ public API
 
@@ -361,19 +353,6 @@ class RotoEnv:
         """n physically valid episode starts (``roto.envs.start_pool.draw_valid_starts``)."""
         return draw_valid_starts(self._draw_candidates, n, self.robot.name)
 
-    def _check_balls_start_clear(self, probes: int = 16) -> None:
-        """Refuse a task whose balls start inside the hand or each other on every probe start (drawn
-        from a generator of its own, so the env's random stream is untouched)."""
-        generator = torch.Generator(device=self.device)
-        generator.manual_seed(0)
-        depth = self._draw_candidates(probes, generator)["ball_penetration"]
-        if bool((depth > MAX_BALL_START_PENETRATION).all()):
-            raise ValueError(
-                f"robot {self.robot.name!r}, task {self.task.name!r}: the balls start {1000 * float(depth.min()):.1f}"
-                f"-{1000 * float(depth.max()):.1f} mm deep inside the hand or each other in all {probes} probe "
-                f"starts (at most {1000 * MAX_BALL_START_PENETRATION:.0f} mm allowed); move the balls' start"
-            )
-
     def _draw_candidates(self, n: int, generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
         """n candidate starts: hand at the default pose + noise, the task's balls placed, zero velocity;
         their qpos (n, nq), joint targets (n, n_act), first frame ("frame/<group>", (n, dim)), the
@@ -397,11 +376,9 @@ class RotoEnv:
         inputs = TaskInputs(ball_pos=selected.ball_pos, ball_vel=selected.ball_vel, ball_contact=torch.zeros(0))
         last_action = torch.zeros(n, self.num_actions, dtype=torch.float32, device=self.device)
         frame = self._frame(selected, inputs, target, last_action)
-        found, dist = idx.self_contact.take(sensors).unbind(-1)
-        penetration = torch.where(found > 0, (-dist).clamp(min=0.0), 0.0)
-        found, dist = idx.ball_clearance.take(sensors).unbind(-1)  # (n, n_ball) each
-        ball_penetration = torch.where(found > 0, (-dist).clamp(min=0.0), 0.0).amax(dim=1)
         frames = {f"frame/{name}": value for name, value in frame.items()}
+        penetration = contact_depth(idx.self_contact.take(sensors))
+        ball_penetration = contact_depth(idx.ball_clearance.take(sensors)).amax(dim=1)  # deepest of the balls
         return {
             "qpos": qpos,
             "target": target,

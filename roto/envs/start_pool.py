@@ -66,6 +66,34 @@ def draw_valid_starts(draw: Callable[[int], Starts], n: int, robot: str) -> Star
     )
 
 
+def contact_depth(found_dist: torch.Tensor) -> torch.Tensor:
+    """Penetration depth (m) from a contact sensor's (found, dist) pairs, (..., 2) -> (...): the
+    deepest contact's overlap, 0 where the sensor found no contact or the contact has a gap."""
+    found, dist = found_dist.unbind(-1)
+    return torch.where(found > 0, (-dist).clamp(min=0.0), 0.0)
+
+
+def check_balls_start_clear(
+    draw: Callable[[int, torch.Generator], Starts], robot: str, task: str, device: torch.device, probes: int = 16
+) -> None:
+    """Refuse a task whose balls start inside the hand or each other in every one of ``probes``
+    candidate starts, ``draw(n, generator)``, drawn from a generator of their own (seed 0) so that
+    the env's random stream is untouched.
+
+    Raises:
+        ValueError naming the robot, the task and the depths.
+    """
+    generator = torch.Generator(device=device)
+    generator.manual_seed(0)
+    depth = draw(probes, generator)["ball_penetration"]
+    if bool((depth > MAX_BALL_START_PENETRATION).all()):
+        raise ValueError(
+            f"robot {robot!r}, task {task!r}: the balls start {1000 * float(depth.min()):.1f}-"
+            f"{1000 * float(depth.max()):.1f} mm deep inside the hand or each other in all {probes} probe starts "
+            f"(at most {1000 * MAX_BALL_START_PENETRATION:.0f} mm allowed); move the balls' start"
+        )
+
+
 class StartPool:
     """A FIFO of episode starts, refilled ``size`` at a time by ``draw(size)``, on ``device``."""
 
