@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import torch
 
-OBS_GROUPS: tuple[str, ...] = ("tactile", "proprio", "privileged")
-"""Every observation group an env can return, in the order the env concatenates them."""
+OBS_GROUPS: tuple[str, ...] = ("tactile", "proprio", "privileged", "task")
+"""Every observation group an env can return, in the order the env concatenates them. ``task`` (the
+task's own state: Baoding's current targets and latches, Bounce's counter state, and the share of
+the episode left) is in no observation mode: it is for critics and other learners that read it
+beside the policy (``EnvConfig.extra_groups``)."""
 
 OBS_MODES: dict[str, tuple[str, ...]] = {
     "blind": ("tactile", "proprio"),
@@ -118,6 +121,22 @@ def privileged_frame(ball_pos: torch.Tensor, ball_vel: torch.Tensor) -> torch.Te
         (B, 6·n_ball) float32, per ball (x, y, z, vx, vy, vz).
     """
     return torch.cat([ball_pos, ball_vel], dim=-1).flatten(1).to(torch.float32)
+
+
+def task_frame(task_observation: torch.Tensor, length: torch.Tensor, episode_steps: int) -> torch.Tensor:
+    """The ``task`` group: the task's state features (``Task.observation``), then the share of the
+    episode left.
+
+    Args:
+        task_observation: (B, k) the task's features.
+        length: (B,) control steps taken so far this episode.
+        episode_steps: control steps per episode.
+
+    Returns:
+        (B, k + 1) float32.
+    """
+    left = 1.0 - length.to(torch.float64) / episode_steps
+    return torch.cat([task_observation.to(torch.float64), left[:, None]], dim=-1).to(torch.float32)
 
 
 class FrameStack:

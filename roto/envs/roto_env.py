@@ -21,15 +21,9 @@ import torch
 from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
+from roto.envs.frames import observation_frame
 from roto.envs.indices import SceneIndices
-from roto.envs.observations import (
-    OBS_GROUPS,
-    OBS_MODES,
-    FrameStack,
-    privileged_frame,
-    proprio_frame,
-    tactile_frame,
-)
+from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, task_frame
 from roto.envs.selections import Selected, Selections
 from roto.envs.spaces import BoundedBox
 from roto.envs.start_pool import StartPool, check_balls_start_clear, contact_depth, draw_valid_starts
@@ -163,7 +157,7 @@ class RotoEnv:
         terminated = result.terminated | diverged
         truncated = (self._episode.length >= self.config.episode_steps) & ~terminated
 
-        frame = self._frame(selected, inputs, self._target, self._last_action)
+        frame = self._frame(selected, self._target, self._last_action, self._task_state_frame())
         self._stack.push(frame)
         obs = self._stack.observation()
 
@@ -252,6 +246,7 @@ class RotoEnv:
             "tactile": len(self.robot.tactile_links) + len(self.layout.taxel_sensor),
             "proprio": 2 * n_obs + 2 * n_act,
             "privileged": 6 * len(self.balls),
+            "task": self.task.observation_size + 1,
         }
         return {group: sizes[group] for group in self.groups}
 
@@ -309,29 +304,20 @@ class RotoEnv:
         return TaskInputs(ball_pos=selected.ball_pos, ball_vel=selected.ball_vel, ball_contact=contact)
 
     def _frame(
-        self,
-        selected: Selected,
-        inputs: TaskInputs,
-        target: torch.Tensor,
-        last_action: torch.Tensor,
+        self, selected: Selected, target: torch.Tensor, last_action: torch.Tensor, task: torch.Tensor | None
     ) -> dict[str, torch.Tensor]:
-        """One observation frame per group from (n, ·) state selections; NaN and inf read as 0 (a
-        diverged world's last frame); the tactile bits are finite by construction."""
+        """The env's groups of one frame (``roto.envs.frames.observation_frame``)."""
         idx = self._idx
-        groups: dict[str, torch.Tensor] = {}
-        if "tactile" in self.groups:
-            config = self.config
-            groups["tactile"] = tactile_frame(
-                config.touch, selected.tactile_force, selected.taxel_force, config.tactile_threshold
-            )
-        groups["proprio"] = proprio_frame(
-            selected.obs_qpos, selected.obs_qvel, idx.obs_lo, idx.obs_hi, target, selected.act_qpos, last_action
-        ).nan_to_num_(nan=0.0, posinf=0.0, neginf=0.0)
-        if "privileged" in self.groups:
-            groups["privileged"] = privileged_frame(inputs.ball_pos, inputs.ball_vel).nan_to_num_(
-                nan=0.0, posinf=0.0, neginf=0.0
-            )
-        return {name: groups[name] for name in self.groups}
+        return observation_frame(self.groups, self.config, selected, idx.obs_lo, idx.obs_hi, target, last_action, task)
+
+    def _task_state_frame(self, state: object = None, length: torch.Tensor | None = None) -> torch.Tensor | None:
+        """The ``task`` group's frame of ``state`` (default: the env's task state) after ``length``
+        (B,) steps (default: the episodes' lengths); None when the env returns no task group."""
+        if "task" not in self.groups:
+            return None
+        state = self.task_state if state is None else state
+        length = self._episode.length if length is None else length
+        return task_frame(self.task.observation(state), length, self.config.episode_steps)
 
     def _reset_where(self, done: torch.Tensor) -> dict[str, torch.Tensor]:
         """Start new episodes in the worlds where ``done`` (B,) is True from the next pooled starts,
@@ -373,10 +359,10 @@ class RotoEnv:
         target = idx.act_qpos.take(qpos).clone()
         sensors = self.backend.sensors_at(qpos, qvel, target).to(self.device, torch.float64)
         selected = self._selections.select(qpos, qvel, sensors[:, None])
-        inputs = TaskInputs(ball_pos=selected.ball_pos, ball_vel=selected.ball_vel, ball_contact=torch.zeros(0))
         last_action = torch.zeros(n, self.num_actions, dtype=torch.float32, device=self.device)
-        frame = self._frame(selected, inputs, target, last_action)
-        frames = {f"frame/{name}": value for name, value in frame.items()}
+        fresh = self.task.init_state(self.robot, n, self.device) if "task" in self.groups else None
+        task = self._task_state_frame(fresh, torch.zeros(n, dtype=torch.int64, device=self.device))
+        frames = {f"frame/{name}": value for name, value in self._frame(selected, target, last_action, task).items()}
         penetration = contact_depth(idx.self_contact.take(sensors))
         ball_penetration = contact_depth(idx.ball_clearance.take(sensors)).amax(dim=1)  # deepest of the balls
         return {

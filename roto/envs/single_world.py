@@ -35,11 +35,12 @@ SingleStep = tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]
 
 def supports_single_world_step(env: RotoEnv) -> bool:
     """Whether ``SingleWorldStep`` can run ``env``: one world on the CPU backend, CPU tensors, binary
-    touch (and each ball's centre and velocity evenly spaced in qpos and qvel, as MuJoCo lays out
-    free joints)."""
+    touch, no ``task`` group (and each ball's centre and velocity evenly spaced in qpos and qvel, as
+    MuJoCo lays out free joints)."""
     cpu = env.device.type == "cpu" and isinstance(env.backend, MujocoCpuBackend) and not env.sync_free_step
     balls_as_views = env._idx.ball_pos.start is not None and env._idx.ball_vel.start is not None
-    return cpu and env.num_envs == 1 and balls_as_views and env.config.touch == "binary"
+    plain = env.config.touch == "binary" and "task" not in env.groups
+    return cpu and env.num_envs == 1 and balls_as_views and plain
 
 
 def _finite(x: np.ndarray) -> np.ndarray:

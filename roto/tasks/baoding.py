@@ -125,6 +125,7 @@ class Baoding:
     """v1: balls dropped from above, roto's diagonal (or side-by-side) targets; v0 started the balls
     on targets where they rest, partly inside the hand."""
     metric_names = ("swaps", "rotations")
+    observation_size = 8
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """Two 55 g balls of the robot's Baoding diameter."""
@@ -173,9 +174,14 @@ class Baoding:
         swaps = state.swaps.to(torch.float32)
         return {"swaps": swaps, "rotations": swaps / 2.0}
 
+    def observation(self, state: BaodingState) -> torch.Tensor:
+        """(B, 8): each ball's current target (task frame, m), then its latch (0 or 1)."""
+        current = torch.where(state.swapped[:, None, None], state.targets.flip(0)[None], state.targets[None])
+        return torch.cat([current.flatten(1), state.latched.to(current.dtype)], dim=1)
+
     def markers(self, state: BaodingState) -> list[Marker]:
         """Each ball's current target, a translucent sphere of the success radius in the ball's colour."""
-        current = torch.where(state.swapped[:, None, None], state.targets.flip(0)[None], state.targets[None])
+        current = self.observation(state)[:, :6].unflatten(1, (2, 3))
         return [
             Marker(pos=current[:, i], radius=SUCCESS_RADIUS, rgba=(*ball.rgba[:3], 0.35))
             for i, ball in enumerate(baoding_balls(0.0))

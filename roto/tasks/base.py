@@ -72,6 +72,8 @@ class Task(Protocol):
     version: int
     """The Gymnasium id's version, bumped whenever dynamics, rewards, observations or terminations change."""
     metric_names: tuple[str, ...]
+    observation_size: int
+    """Features per world of ``observation`` (the ``task`` observation group holds one more: time left)."""
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """The free objects this task puts in the scene for ``robot``."""
@@ -96,6 +98,10 @@ class Task(Protocol):
 
     def metrics(self, state: object) -> dict[str, torch.Tensor]:
         """Episode metrics so far, name -> (B,) float."""
+        ...
+
+    def observation(self, state: object) -> torch.Tensor:
+        """(B, observation_size) float features of the task state a critic may read (never the policy)."""
         ...
 
     def markers(self, state: object) -> list[Marker]:

@@ -65,6 +65,7 @@ class Bounce:
     display_name = "Bounce"
     version = 0
     metric_names = ("bounces",)
+    observation_size = 3
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """One 70 mm, 30 g ball for every hand."""
@@ -102,6 +103,12 @@ class Bounce:
     def metrics(self, state: BounceState) -> dict[str, torch.Tensor]:
         """Bounces so far this episode."""
         return {"bounces": state.bounces.to(torch.float32)}
+
+    def observation(self, state: BounceState) -> torch.Tensor:
+        """(B, 3): contact in the previous step, waiting for a bounce, and the flight so far as a share
+        of the ``MIN_FLIGHT_STEPS`` a bounce needs (capped at 1); each in [0, 1]."""
+        flight = (state.steps_without_contact.to(torch.float64) / MIN_FLIGHT_STEPS).clamp(max=1.0)
+        return torch.stack([state.prev_contact.to(flight.dtype), state.waiting.to(flight.dtype), flight], dim=1)
 
     def markers(self, state: BounceState) -> list[Marker]:
         """None: Bounce has no targets."""

@@ -62,12 +62,13 @@ def first_frame_from_world(env, world: int) -> dict[str, torch.Tensor]:
     target = env._target[world : world + 1]
     sensors = env.backend.sensors_at(qpos, qvel, target).to(torch.float64)
     selected = env._selections.select(qpos, qvel, sensors[:, None])
-    return env._frame(selected, env._task_inputs(selected), target, torch.zeros(1, env.num_actions))
+    task = env._task_state_frame()[world : world + 1]  # the world's task state, cleared by its reset
+    return env._frame(selected, target, torch.zeros(1, env.num_actions), task)
 
 
 @pytest.mark.parametrize(("task", "robot"), list_envs())
 def test_a_pooled_reset_shows_the_first_frame_of_the_state_it_wrote(task, robot):
-    env = make_env(task, robot=robot, num_envs=4, obs_mode="state", seed=1)
+    env = make_env(task, robot=robot, num_envs=4, obs_mode="state", extra_groups=("task",), seed=1)
     gen = torch.Generator().manual_seed(0)
     env.reset()
     resets = 0
