@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
+import pathlib
 from dataclasses import dataclass
 
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, TOUCH_MODES
@@ -38,6 +40,11 @@ class EnvConfig:
         nconmax: contacts per world the ``warp`` backend allocates (None: roto's measured figure for
             this robot and task, ``roto.envs.capacity``).
         njmax: constraint rows per world for ``warp`` (None: as for ``nconmax``).
+        replay_starts: a training aid: an ``.npz`` of recorded states (``roto demo --task baoding
+            --preswap_out``: states just before swaps) that episodes may start from.
+        replay_share: the share of episode starts drawn from ``replay_starts`` instead of the
+            task's own starts (0: none). Training only: evaluation envs always start from the
+            task's own starts (``without_training_aids``).
     """
 
     task: str
@@ -58,6 +65,8 @@ class EnvConfig:
     reset_joint_noise: float = 0.2
     nconmax: int | None = None
     njmax: int | None = None
+    replay_starts: str | None = None
+    replay_share: float = 0.0
 
     def __post_init__(self) -> None:
         """Reject impossible values with a message naming the value and the valid choices."""
@@ -90,7 +99,21 @@ class EnvConfig:
             value = getattr(self, name)
             if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
                 raise ValueError(f"{name} must be an integer >= 1 or None, got {value!r}")
+        self._check_replay()
         self._check_device()
+
+    def without_training_aids(self) -> EnvConfig:
+        """This config as the benchmark defines the task: no replayed starts."""
+        return dataclasses.replace(self, replay_starts=None, replay_share=0.0)
+
+    def _check_replay(self) -> None:
+        share = self.replay_share
+        if isinstance(share, bool) or not isinstance(share, (int, float)) or not 0.0 <= share <= 1.0:
+            raise ValueError(f"replay_share must be a number in [0, 1], got {share!r}")
+        if share > 0.0 and self.replay_starts is None:
+            raise ValueError(f"replay_share {share} needs replay_starts (an .npz of recorded states); got none")
+        if self.replay_starts is not None and not pathlib.Path(self.replay_starts).is_file():
+            raise ValueError(f"replay_starts {str(self.replay_starts)!r} is not a file")
 
     def _check_device(self) -> None:
         device = str(self.device)

@@ -24,16 +24,18 @@ from roto.envs.control import action_to_target, smooth_target, target_to_action
 from roto.envs.frames import observation_frame
 from roto.envs.indices import SceneIndices
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, task_frame
+from roto.envs.replay_starts import ReplayBank, load_replay_bank
 from roto.envs.selections import Selected, Selections
 from roto.envs.spaces import BoundedBox
-from roto.envs.start_pool import StartPool, check_balls_start_clear, contact_depth, draw_valid_starts
+from roto.envs.start_draw import draw_candidates, draw_starts
+from roto.envs.start_pool import StartPool, check_balls_start_clear
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
 from roto.sim.backend import make_backend
 from roto.sim.host_sync import deliberate_host_sync, resolve_device
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
-from roto.tasks.base import TaskInputs, uniform
+from roto.tasks.base import TaskInputs
 
 DEVICE_CHECK_EVERY = 16
 """Steps between the host reads of a GPU env (pool of starts, action finiteness)."""
@@ -86,6 +88,7 @@ class RotoEnv:
         self._target = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
         self._last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
         self._zero_qvel = torch.zeros(self.num_envs, self.model.nv, dtype=torch.float64, device=self.device)
+        self.replay_bank = self._load_replay_bank()
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
@@ -199,6 +202,7 @@ class RotoEnv:
             "starts": self._starts.state_dict(),
             "nonfinite_resets": self.nonfinite_resets,
             "needs_reset": self._needs_reset,
+            **({"replay_bank": self.replay_bank.state_dict()} if self.replay_bank is not None else {}),
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -217,6 +221,8 @@ class RotoEnv:
             self._starts.load_state_dict(state["starts"], self.device)
         else:  # saved before episode starts were pooled: draw afresh
             self._starts.clear()
+        if "replay_bank" in state:  # the states the run drew from, whatever the file holds now
+            self.replay_bank = ReplayBank.from_state_dict(state["replay_bank"], self.device)
         self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
         if not self._needs_reset:  # the pool covers the steps until the next check (same draws, earlier)
@@ -325,8 +331,13 @@ class RotoEnv:
         Fixed shapes throughout: nothing is read back from the device."""
         start = self._starts.take_where(done)
         rows = done[:, None]
-        self.backend.set_state_where(done, start["qpos"], self._zero_qvel)
+        self.backend.set_state_where(done, start["qpos"], start.get("qvel", self._zero_qvel))
         self.task.reset(self.task_state, done)
+        for key, recorded in start.items():  # the task state a replayed start was recorded in
+            if key.startswith("task/"):
+                field = getattr(self.task_state, key[5:])
+                where = done.view(-1, *[1] * (field.dim() - 1))
+                setattr(self.task_state, key[5:], torch.where(where, recorded.to(field.dtype), field))
         self._target = torch.where(rows, start["target"], self._target)
         self._last_action.masked_fill_(rows, 0.0)
         self._episode.length.masked_fill_(done, 0)
@@ -336,42 +347,20 @@ class RotoEnv:
         return {name: start[f"frame/{name}"] for name in self.groups}
 
     def _draw_starts(self, n: int) -> dict[str, torch.Tensor]:
-        """n physically valid episode starts (``roto.envs.start_pool.draw_valid_starts``)."""
-        return draw_valid_starts(self._draw_candidates, n, self.robot.name)
+        """n episode starts (``roto.envs.start_draw.draw_starts``)."""
+        return draw_starts(self, n, self._generator)
+
+    def _load_replay_bank(self) -> ReplayBank | None:
+        """The recorded states the config's ``replay_starts`` names, on the env's device (or None)."""
+        path = self.config.replay_starts
+        if path is None:
+            return None
+        return load_replay_bank(path, self.model, self.robot.name, self.task_state, self.num_actions).to(self.device)
 
     def _draw_candidates(self, n: int, generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
-        """n candidate starts: hand at the default pose + noise, the task's balls placed, zero velocity;
-        their qpos (n, nq), joint targets (n, n_act), first frame ("frame/<group>", (n, dim)), the
-        depth (m) of the hand's deepest self-contact ("penetration", (n,)) and of the balls' deepest
-        contact with the hand or each other ("ball_penetration", (n,)). Random draws come from
-        ``generator`` (default: the env's)."""
-        generator = generator or self._generator
-        idx = self._idx
-        qpos = idx.default_qpos.expand(n, -1).clone()
-        noise = uniform(generator, (n, self.num_actions), self.config.reset_joint_noise, self.device)
-        idx.act_qpos.put(qpos, torch.clamp(idx.act_qpos.take(qpos) + noise, idx.ctrl_lo, idx.ctrl_hi))
-        idx.coupled_driven.put(
-            qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
-        )
-        ball_pos = self.task.initial_ball_positions(self.task_state, n, generator)
-        idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))  # the default pose holds the balls' identity quaternions
-        qvel = qpos.new_zeros(n, self.model.nv)
-        target = idx.act_qpos.take(qpos).clone()
-        sensors = self.backend.sensors_at(qpos, qvel, target).to(self.device, torch.float64)
-        selected = self._selections.select(qpos, qvel, sensors[:, None])
-        last_action = torch.zeros(n, self.num_actions, dtype=torch.float32, device=self.device)
-        fresh = self.task.init_state(self.robot, n, self.device) if "task" in self.groups else None
-        task = self._task_state_frame(fresh, torch.zeros(n, dtype=torch.int64, device=self.device))
-        frames = {f"frame/{name}": value for name, value in self._frame(selected, target, last_action, task).items()}
-        penetration = contact_depth(idx.self_contact.take(sensors))
-        ball_penetration = contact_depth(idx.ball_clearance.take(sensors)).amax(dim=1)  # deepest of the balls
-        return {
-            "qpos": qpos,
-            "target": target,
-            **frames,
-            "penetration": penetration,
-            "ball_penetration": ball_penetration,
-        }
+        """n candidate starts (``roto.envs.start_draw.draw_candidates``), drawn from ``generator``
+        (default: the env's)."""
+        return draw_candidates(self, n, generator or self._generator)
 
     def _episode_info(self, truncated: torch.Tensor) -> dict[str, torch.Tensor]:
         info = {

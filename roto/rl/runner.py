@@ -93,7 +93,9 @@ class Trainer:
         self.device = self.env.device  # the policy learns where the envs simulate
         num_eval = agent.run.num_eval_envs_gpu if self.device.type == "cuda" else agent.run.num_eval_envs
         eval_seed = settings.env.seed + EVAL_SEED_OFFSET
-        self.evaluator = PolicyEvaluator(env_factory(settings.env_config(num_eval, eval_seed)), eval_seed, self.run_dir)
+        self.evaluator = PolicyEvaluator(
+            env_factory(settings.eval_env_config(num_eval, eval_seed)), eval_seed, self.run_dir
+        )
         torch.manual_seed(settings.env.seed)
         sizes = stacked_sizes(self.env)
         self.model = build_model(sizes, self.env.num_actions, agent, settings.env.obs_mode).to(self.device)

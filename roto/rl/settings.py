@@ -32,9 +32,14 @@ class TrainSettings:
         changes.update({name: value for name, value in (("num_envs", num_envs), ("seed", seed)) if value is not None})
         return dataclasses.replace(self.env, **changes)
 
+    def eval_env_config(self, num_envs: int | None = None, seed: int | None = None, **changes: Any) -> EnvConfig:
+        """As ``env_config``, without training aids (``EnvConfig.without_training_aids``): evaluation
+        is always the benchmark's own task."""
+        return self.env_config(num_envs, seed, **changes).without_training_aids()
+
     def cpu_env_config(self, num_envs: int | None = None, seed: int | None = None, **changes: Any) -> EnvConfig:
-        """As ``env_config``, on the CPU backend: evaluation and videos of any run, GPU-trained too."""
-        return self.env_config(num_envs, seed, backend="cpu", device="cpu", **changes)
+        """As ``eval_env_config``, on the CPU backend: evaluation and videos of any run, GPU-trained too."""
+        return self.eval_env_config(num_envs, seed, backend="cpu", device="cpu", **changes)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain nested dict of builtins (for config.yaml and checkpoints)."""

@@ -1,0 +1,107 @@
+"""Candidate episode starts of a ``RotoEnv``: the task's own starts, and recorded states mixed in.
+
+A start is, with probability ``EnvConfig.replay_share``, a state drawn from the env's bank of
+recorded states (``roto.envs.replay_starts``) with the task state it was recorded in, kept as
+recorded; otherwise one of the task's own starts: the hand at its default pose plus joint noise
+with the task's balls placed, at rest, redrawn until valid (``roto.envs.start_pool.draw_valid_starts``).
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import TYPE_CHECKING
+
+import torch
+
+from roto.envs.start_pool import contact_depth, draw_valid_starts
+from roto.tasks.base import uniform
+
+if TYPE_CHECKING:
+    from roto.envs.roto_env import RotoEnv
+
+
+def draw_starts(env: RotoEnv, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
+    """n valid episode starts of ``env``: each is, with probability ``replay_share``, a recorded state
+    (``replayed_starts``), else one of the task's own starts (``draw_candidates``, redrawn until
+    valid). Rows as ``draw_candidates``' without the depths, plus "replayed" (n,) bool and the
+    recorded task state fields ("task/<field>", zero where fresh) when the env replays."""
+    fresh = functools.partial(draw_candidates, env, generator=generator)
+    share, bank = env.config.replay_share, env.replay_bank
+    if bank is None or share == 0.0:
+        return draw_valid_starts(fresh, n, env.robot.name)
+    replayed = torch.rand(n, generator=generator, device=env.device) < share
+    parts = []
+    if bool(replayed.any()):
+        parts.append((replayed, replayed_starts(env, int(replayed.sum()), generator)))
+    if not bool(replayed.all()):
+        own = draw_valid_starts(fresh, int((~replayed).sum()), env.robot.name)
+        k = len(own["qpos"])
+        own.update({f"task/{name}": values.new_zeros((k, *values.shape[1:])) for name, values in bank.task.items()})
+        parts.append((~replayed, own))
+    starts = {name: rows.new_zeros((n, *rows.shape[1:])) for name, rows in parts[0][1].items()}
+    for mask, rows in parts:
+        for name, value in rows.items():
+            starts[name][mask] = value
+    starts["replayed"] = replayed
+    return starts
+
+
+def replayed_starts(env: RotoEnv, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
+    """n starts drawn uniformly from the env's bank of recorded states: their qpos, qvel, joint
+    targets, recorded task state ("task/<field>") and first frame, rows as ``draw_starts``'."""
+    bank = env.replay_bank
+    pick = torch.randint(len(bank), (n,), generator=generator, device=env.device)
+    qpos, qvel, target = bank.qpos[pick], bank.qvel[pick], bank.target[pick]
+    task_rows = {name: values[pick] for name, values in bank.task.items()}
+    frame, _ = first_frame(env, qpos, qvel, target, task_rows)
+    recorded = {f"task/{name}": rows for name, rows in task_rows.items()}
+    return {"qpos": qpos, "qvel": qvel, "target": target, **recorded, **frame}
+
+
+def first_frame(
+    env: RotoEnv, qpos: torch.Tensor, qvel: torch.Tensor, target: torch.Tensor, task_rows: dict[str, torch.Tensor]
+) -> tuple[dict[str, torch.Tensor], torch.Tensor]:
+    """The first observation frame ("frame/<group>" -> (n, dim)) of n starts, and their sensor
+    values (n, nsensordata); ``task_rows`` are the task state fields the starts begin with (the
+    others, and all without them, as a reset leaves them)."""
+    device = env.device
+    n = len(qpos)
+    sensors = env.backend.sensors_at(qpos, qvel, target).to(device, torch.float64)
+    selected = env._selections.select(qpos, qvel, sensors[:, None])
+    last_action = torch.zeros(n, env.num_actions, dtype=torch.float32, device=device)
+    task_frame = None
+    if "task" in env.groups:
+        first = env.task.init_state(env.robot, n, device)
+        for name, rows in task_rows.items():
+            setattr(first, name, rows.to(getattr(first, name).dtype))
+        task_frame = env._task_state_frame(first, torch.zeros(n, dtype=torch.int64, device=device))
+    frame = env._frame(selected, target, last_action, task_frame)
+    return {f"frame/{name}": value for name, value in frame.items()}, sensors
+
+
+def draw_candidates(env: RotoEnv, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
+    """n candidates of the task's own starts: the hand at its default pose plus noise, the task's
+    balls placed, at rest; their qpos (n, nq), qvel (n, nv, zero), joint targets (n, n_act), first
+    frame ("frame/<group>"), and the depth (m) of the hand's deepest self-contact ("penetration",
+    (n,)) and of the balls' deepest contact with the hand or each other ("ball_penetration", (n,)).
+    Random draws come from ``generator``."""
+    idx, device = env._idx, env.device
+    qpos = idx.default_qpos.expand(n, -1).clone()
+    noise = uniform(generator, (n, env.num_actions), env.config.reset_joint_noise, device)
+    idx.act_qpos.put(qpos, torch.clamp(idx.act_qpos.take(qpos) + noise, idx.ctrl_lo, idx.ctrl_hi))
+    idx.coupled_driven.put(
+        qpos, torch.clamp(idx.coupled_driver.take(qpos) * idx.coupled_ratio, idx.coupled_lo, idx.coupled_hi)
+    )
+    ball_pos = env.task.initial_ball_positions(env.task_state, n, generator)
+    idx.ball_pos.put(qpos, ball_pos.to(qpos.dtype))  # the default pose holds the balls' identity quaternions
+    qvel = qpos.new_zeros(n, env.model.nv)
+    target = idx.act_qpos.take(qpos).clone()
+    frame, sensors = first_frame(env, qpos, qvel, target, {})
+    return {
+        "qpos": qpos,
+        "qvel": qvel,
+        "target": target,
+        **frame,
+        "penetration": contact_depth(idx.self_contact.take(sensors)),
+        "ball_penetration": contact_depth(idx.ball_clearance.take(sensors)).amax(dim=1),  # deepest ball
+    }
