@@ -130,10 +130,18 @@ def _cmd_train(args: argparse.Namespace) -> int:
     from roto.rl.config import load_agent_config
     from roto.rl.overrides import apply_env_overrides, split_overrides
     from roto.rl.runner import Trainer, TrainSettings
+    from roto.rl.settings import CONFIG_NAME
 
+    if isinstance(args.torch_threads, bool) or args.torch_threads < 1:
+        raise ValueError(f"--torch_threads must be an integer >= 1, got {args.torch_threads}")
     torch.set_num_threads(args.torch_threads)
     wandb_project = args.wandb_project if args.logger == "wandb" else None
     if args.resume:
+        if args.overrides:
+            raise ValueError(
+                f"--resume continues a run as it was configured; the overrides {args.overrides} would be ignored: "
+                "drop them, or start a new run with --run_dir"
+            )
         trainer = Trainer.resume(args.resume, total_steps=args.steps, wandb_project=wandb_project)
     else:
         env_changes, agent_overrides = split_overrides(args.overrides)
@@ -154,6 +162,11 @@ def _cmd_train(args: argparse.Namespace) -> int:
         run_dir = args.run_dir or pathlib.Path("runs") / (
             f"{args.task}_{args.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{args.seed}"
         )
+        if (pathlib.Path(run_dir) / CONFIG_NAME).exists():
+            raise ValueError(
+                f"--run_dir {str(run_dir)!r} already holds a run; continue it with --resume {str(run_dir)!r}, "
+                "or choose another directory"
+            )
         trainer = Trainer(settings, agent, run_dir, wandb_project=wandb_project)
     print(f"run directory: {trainer.run_dir}", file=sys.stderr)
     last = trainer.train(progress=not args.no_progress)
@@ -170,10 +183,12 @@ def _cmd_eval(args: argparse.Namespace) -> int:
     from roto.eval.evaluate import evaluate
     from roto.rl.runner import load_policy
 
+    out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
+    if not out.parent.is_dir():  # before the evaluation, which would be lost
+        raise FileNotFoundError(f"--out: directory {str(out.parent)!r} does not exist")
     model, settings, _ = load_policy(args.checkpoint)
     result = evaluate(model, settings, episodes=args.episodes, seed=args.seed)
     result = {"checkpoint": str(args.checkpoint), "task": settings.env.task, "robot": settings.env.robot, **result}
-    out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
     out.write_text(json.dumps(result, indent=1))
     print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))
     print(f"wrote {out}", file=sys.stderr)

@@ -173,3 +173,31 @@ def test_a_force_touch_run_keeps_its_touch_through_eval(tmp_path, capsys):
     assert not reconstruction.binary_tactile
     trainer.env.close()
     trainer.evaluator.env.close()
+
+
+def test_train_refuses_an_existing_run_and_leaves_it_untouched(trained_run, capsys):
+    before = {p: p.read_bytes() for p in [trained_run / "config.yaml", trained_run / "checkpoints" / "latest.pt"]}
+    args = ["train", "--num_envs", "4", "--steps", "48", "--run_dir", str(trained_run), "--no_progress", *TINY]
+    assert main(args) == 2
+    assert f"already holds a run; continue it with --resume '{trained_run}'" in capsys.readouterr().err
+    assert all(path.read_bytes() == data for path, data in before.items())
+
+
+def test_resume_refuses_overrides_and_a_budget_below_what_is_done(trained_run, capsys):
+    config = (trained_run / "config.yaml").read_bytes()
+    assert main(["train", "--resume", str(trained_run), "--no_progress", "ppo.lr=1e-3"]) == 2
+    assert "the overrides ['ppo.lr=1e-3'] would be ignored" in capsys.readouterr().err
+    assert main(["train", "--resume", str(trained_run), "--steps", "16", "--no_progress"]) == 2
+    assert "step budget 16 is below the" in capsys.readouterr().err
+    assert (trained_run / "config.yaml").read_bytes() == config  # a refused resume rewrites nothing
+
+
+def test_eval_into_a_missing_directory_fails_before_evaluating(trained_run, tmp_path, capsys):
+    out = tmp_path / "nowhere" / "eval.json"
+    assert main(["eval", "--checkpoint", str(trained_run / "checkpoints" / "latest.pt"), "--out", str(out)]) == 2
+    assert f"--out: directory {str(out.parent)!r} does not exist" in capsys.readouterr().err
+
+
+def test_zero_torch_threads_is_a_clear_error(capsys):
+    assert main(["train", "--steps", "16", "--torch_threads", "0"]) == 2
+    assert "--torch_threads must be an integer >= 1, got 0" in capsys.readouterr().err

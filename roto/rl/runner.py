@@ -274,13 +274,19 @@ class Trainer:
         checkpoint = run_dir / CHECKPOINT_DIR / "latest.pt"
         if not checkpoint.is_file():
             raise FileNotFoundError(f"no checkpoint to resume from: {str(checkpoint)!r} does not exist")
+        state = load_checkpoint(checkpoint)  # read before anything is built or written
+        if total_steps is not None and total_steps < int(state["env_steps"]):
+            raise ValueError(
+                f"step budget {total_steps} is below the {int(state['env_steps'])} env steps {str(run_dir)!r} has "
+                "already done; give a budget at least that large"
+            )
         if total_steps is not None:
             settings = TrainSettings(env=settings.env, total_steps=total_steps)
         wandb_project = logged_wandb_project(run_dir) or wandb_project
         trainer = cls(
             settings, agent, run_dir, tensorboard=tensorboard, env_factory=env_factory, wandb_project=wandb_project
         )
-        trainer.load_state_dict(load_checkpoint(checkpoint, trainer.device))
+        trainer.load_state_dict(state if trainer.device.type == "cpu" else load_checkpoint(checkpoint, trainer.device))
         return trainer
 
 
