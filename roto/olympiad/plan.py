@@ -25,8 +25,6 @@ import pathlib
 from dataclasses import dataclass
 from typing import Any
 
-import yaml
-
 from roto.envs.observations import OBS_MODES
 from roto.rl.build import resolve_groups
 from roto.rl.config import load_agent_config
@@ -34,6 +32,7 @@ from roto.rl.overrides import split_overrides
 from roto.robots import ROBOTS
 from roto.sim.backend import BACKENDS
 from roto.tasks import TASKS
+from roto.yaml_files import read_yaml
 
 PLAN_KEYS = {"description", "steps", "eval_episodes", "num_envs", "threads", "backend", "device", "variants", "grids"}
 VARIANT_KEYS = {"agent_cfg", "overrides"}
@@ -103,7 +102,7 @@ def load_plan(plan: str) -> Plan:
     path = shipped.get(plan) or pathlib.Path(plan)
     if not path.is_file():
         raise FileNotFoundError(f"plan {plan!r} does not exist; give a YAML file or a packaged plan: {sorted(shipped)}")
-    data = yaml.safe_load(path.read_text()) or {}
+    data = read_yaml(path, "plan") or {}
     where = f"plan {plan!r}"
     _check_keys(data, PLAN_KEYS, where)
     numbers = {key: data.get(key, default) for key, default in

@@ -20,6 +20,7 @@ from typing import Any
 import yaml
 
 from roto.rl.ssl.configs import SSLConfig, check_groups
+from roto.yaml_files import read_yaml
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -185,7 +186,10 @@ def parse_override(item: str) -> tuple[str, Any]:
     key, sep, raw = item.partition("=")
     if not sep or not key:
         raise ValueError(f"override {item!r} must look like section.key=value (e.g. ppo.lr=1e-4)")
-    return key, yaml.safe_load(raw)
+    try:
+        return key, yaml.safe_load(raw)
+    except yaml.YAMLError:
+        raise ValueError(f"override {item!r}: the value {raw!r} is not valid YAML") from None
 
 
 def apply_overrides(data: dict[str, Any], overrides: list[str]) -> dict[str, Any]:
@@ -228,7 +232,10 @@ def load_agent_config(
     task: str, path: str | pathlib.Path | None = None, overrides: list[str] | None = None
 ) -> AgentConfig:
     """The task's default config, or ``path`` (a YAML file or packaged name), with ``overrides``; validated."""
-    data = yaml.safe_load(resolve_config_path(task, path).read_text()) or {}
+    config_path = resolve_config_path(task, path)
+    data = read_yaml(config_path, "agent config")
+    if data is None:
+        raise ValueError(f"agent config {str(config_path)!r} is empty; it would train on defaults it never names")
     data = apply_overrides(data, overrides or [])
     return from_dict(AgentConfig, data).validate()
 

@@ -11,6 +11,7 @@ import yaml
 
 from roto.envs.config import EnvConfig
 from roto.rl.config import AgentConfig, from_dict, to_dict
+from roto.yaml_files import read_yaml
 
 CONFIG_NAME = "config.yaml"
 
@@ -68,5 +69,7 @@ def read_run_config(run_dir: pathlib.Path) -> tuple[TrainSettings, AgentConfig]:
     path = run_dir / CONFIG_NAME
     if not path.is_file():
         raise FileNotFoundError(f"{str(run_dir)!r} is not a roto run directory (no {CONFIG_NAME})")
-    data = yaml.safe_load(path.read_text())
+    data = read_yaml(path, "run config")
+    if not isinstance(data, dict) or not {"train", "agent"} <= set(data):
+        raise ValueError(f"run config {str(path)!r} is not a roto run config (no 'train' and 'agent' sections)")
     return TrainSettings.from_dict(data["train"]), from_dict(AgentConfig, data["agent"]).validate()

@@ -24,12 +24,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import optuna
-import yaml
 
 from roto.envs.config import EnvConfig
 from roto.rl.config import AgentConfig, from_dict, load_agent_config
 from roto.rl.overrides import apply_env_overrides, split_overrides
 from roto.rl.ssl.configs import SSLConfig
+from roto.yaml_files import read_yaml
 
 DISTRIBUTION_KEYS = {
     "int": {"type", "low", "high", "log", "step"},
@@ -138,7 +138,7 @@ def load_space(space: str, env: EnvConfig, agent_cfg: str | None = None, overrid
     valid config on top of the base env (``env`` with the env part of ``overrides``) and agent:
     otherwise ValueError naming the parameter and the valid choices.
     """
-    data = yaml.safe_load(resolve_space_path(space).read_text()) or {}
+    data = read_yaml(resolve_space_path(space), "search space") or {}
     where = f"search space {space!r}"
     if not isinstance(data, dict) or set(data) - set(SPACE_KEYS):
         extra = sorted(set(data) - set(SPACE_KEYS)) if isinstance(data, dict) else data
