@@ -15,6 +15,7 @@ import numpy as np
 import torch
 
 from roto.sim.backend import SimState
+from roto.sim.memory import check_fits
 from roto.sim.one_world import OneWorldStep
 from roto.sim.rollout_threads import RolloutThreads
 
@@ -37,6 +38,7 @@ class MujocoCpuBackend:
     def __init__(self, model: mujoco.MjModel, num_worlds: int, *, substeps: int, threads: int = 1) -> None:
         if threads < 1:
             raise ValueError(f"threads must be >= 1, got {threads}")
+        check_fits(model, num_worlds, substeps)  # before any allocation
         self.model = model
         self.num_worlds = num_worlds
         self.substeps = substeps
