@@ -40,5 +40,5 @@ def check_fits(model: mujoco.MjModel, num_worlds: int, substeps: int, available:
         most = max(1, num_worlds * available // need)
         raise ValueError(
             f"num_envs {num_worlds} needs at least {need / GIB:.1f} GiB for its physics arrays alone; this machine "
-            f"has {available / GIB:.1f} GiB available, in which the physics arrays alone of at most {most} envs would fit"
+            f"has {available / GIB:.1f} GiB available, which holds those of at most {most} envs"
         )

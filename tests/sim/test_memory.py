@@ -21,5 +21,5 @@ def test_the_estimate_scales_with_the_worlds_and_the_limit_names_what_fits():
     one = cpu_batch_bytes(model, 1, 4)
     assert cpu_batch_bytes(model, 1000, 4) == 1000 * one and one > 8 * model.nq
     check_fits(model, 1000, 4, available=1000 * one)  # exactly fits
-    with pytest.raises(ValueError, match=r"alone of at most 999 envs would fit"):
+    with pytest.raises(ValueError, match=r"which holds those of at most 999 envs"):
         check_fits(model, 1000, 4, available=1000 * one - 1)
