@@ -19,6 +19,7 @@ import pathlib
 import sys
 import threading
 import time
+import urllib.parse
 import warnings
 
 import optuna
@@ -40,6 +41,15 @@ with warnings.catch_warnings():  # Optuna marks the callback experimental; roto 
     enqueue_retry = RetryHeartbeatStaleTrialCallback(max_retry=MAX_RETRY)
 """``enqueue_retry(study, failed_trial)``: a waiting copy of the trial, its system attribute
 ``RETRY_OF_ATTR`` naming the first try."""
+
+
+def redact_url(url: str) -> str:
+    """``url`` with its password replaced by ``***`` (for messages and logs)."""
+    parts = urllib.parse.urlsplit(url)
+    if parts.password is None:
+        return url
+    netloc = parts.netloc.replace(f":{parts.password}@", ":***@", 1)
+    return urllib.parse.urlunsplit(parts._replace(netloc=netloc))
 
 
 def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.storages.BaseStorage:

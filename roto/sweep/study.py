@@ -5,13 +5,17 @@ from __future__ import annotations
 import dataclasses
 import pathlib
 import random
+import re
 from dataclasses import dataclass
 from typing import Any
 
 import optuna
 
 from roto.envs.config import EnvConfig
-from roto.sweep.storage import JOURNAL_NAME, find_study, open_storage
+from roto.sweep.storage import JOURNAL_NAME, find_study, open_storage, redact_url
+
+STUDY_NAME = re.compile(r"[A-Za-z0-9._-]+")
+"""A study name: one folder name under ``--root``, nothing that climbs out of it."""
 
 SEEDS = (0, 1, 2, 3, 4)
 """Each trial trains with one of these seeds, drawn per trial (docs/spec.md §8)."""
@@ -50,8 +54,7 @@ class SweepSettings:
 
     def __post_init__(self) -> None:
         """Reject values no sweep can use."""
-        if not self.study or "/" in self.study:
-            raise ValueError(f"the study name must be a non-empty name without '/', got {self.study!r}")
+        check_study_name(self.study)
         for name in ("trials", "steps", "num_envs", "threads"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
@@ -113,11 +116,20 @@ def open_study(settings: SweepSettings) -> tuple[optuna.Study, optuna.storages.B
     return study, storage
 
 
+def check_study_name(name: str) -> None:
+    """Refuse a study name that is not a plain name (it names a folder under ``--root``)."""
+    if not isinstance(name, str) or not STUDY_NAME.fullmatch(name) or set(name) == {"."}:
+        raise ValueError(
+            f"the study name must be a plain name (letters, digits, '.', '_', '-'; not '.' or '..'), got {name!r}"
+        )
+
+
 def load_existing_study(name: str, root: str, storage_url: str | None) -> tuple[optuna.Study, dict[str, Any]]:
     """An existing study and its stored settings (for ``export`` and ``show``)."""
+    check_study_name(name)
     study = find_study(pathlib.Path(root) / name, name, storage_url)
     if study is None and storage_url is not None:
-        raise ValueError(f"no study {name!r} in the storage {storage_url!r}")
+        raise ValueError(f"no study {name!r} in the storage {redact_url(storage_url)!r}")
     if study is None:
         found = sorted(p.parent.name for p in pathlib.Path(root).glob(f"*/{JOURNAL_NAME}"))
         raise ValueError(f"no study {name!r} under {root!r}; studies there: {found}")
