@@ -15,6 +15,7 @@ directory from its latest checkpoint. This works the same on the journal and on 
 
 from __future__ import annotations
 
+import importlib.util
 import pathlib
 import sys
 import threading
@@ -23,6 +24,7 @@ import urllib.parse
 import warnings
 
 import optuna
+import sqlalchemy.exc
 from optuna.exceptions import UpdateFinishedTrialError
 from optuna.storages import RetryHeartbeatStaleTrialCallback
 from optuna.storages.journal import JournalFileBackend, JournalStorage
@@ -52,10 +54,37 @@ def redact_url(url: str) -> str:
     return urllib.parse.urlunsplit(parts._replace(netloc=netloc))
 
 
+CONNECT_TIMEOUT_S = 10
+"""Seconds a database connection may take before the storage gives up (a host that accepts the
+connection and never answers would otherwise hang the command)."""
+
+
+def database_url(url: str) -> str:
+    """``url`` with a driver SQLAlchemy can load: plain ``postgresql://`` means psycopg 3 to
+    SQLAlchemy 2.1, so it becomes ``postgresql+psycopg2://`` where only psycopg2 (roto's
+    ``postgres`` extra) is installed."""
+    scheme, sep, rest = url.partition("://")
+    only_psycopg2 = importlib.util.find_spec("psycopg") is None and importlib.util.find_spec("psycopg2") is not None
+    return f"postgresql+psycopg2://{rest}" if scheme == "postgresql" and sep and only_psycopg2 else url
+
+
 def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.storages.BaseStorage:
-    """The journal file in ``study_dir`` (created), or the database at ``url``."""
+    """The journal file in ``study_dir`` (created), or the database at ``url``.
+
+    Raises:
+        ValueError naming the URL (password hidden) when the database cannot be reached in
+        ``CONNECT_TIMEOUT_S`` or refuses the connection.
+    """
     if url:
-        return optuna.storages.RDBStorage(url)
+        driver_url = database_url(url)
+        engine = {"pool_pre_ping": True}  # a connection the server dropped is replaced, not used
+        if driver_url.startswith("postgresql"):
+            engine["connect_args"] = {"connect_timeout": CONNECT_TIMEOUT_S}
+        try:
+            return optuna.storages.RDBStorage(driver_url, engine_kwargs=engine)
+        except sqlalchemy.exc.SQLAlchemyError as error:
+            reason = str(getattr(error, "orig", None) or error).strip().splitlines()[0]
+            raise ValueError(f"cannot open the storage {redact_url(url)!r}: {reason}") from None
     study_dir.mkdir(parents=True, exist_ok=True)
     return JournalStorage(JournalFileBackend(str(study_dir / JOURNAL_NAME)))
 

@@ -33,3 +33,32 @@ def test_a_missing_study_in_a_database_is_reported_without_the_password(monkeypa
     assert "s3cret" not in str(error.value) and "roto:***@host" in str(error.value)
     with pytest.raises(ValueError, match="plain name"):
         load_existing_study("..", "runs/sweeps", None)
+
+
+def test_plain_postgresql_urls_reach_the_server_through_the_installed_driver(postgres_url, tmp_path):
+    import optuna
+
+    from roto.sweep.storage import open_storage
+
+    plain = postgres_url.replace("postgresql+psycopg2://", "postgresql://")
+    storage = open_storage(tmp_path, plain)  # the --help's example form
+    optuna.create_study(study_name="plain_url", storage=storage)
+    assert "plain_url" in [s.study_name for s in optuna.get_all_study_summaries(storage)]
+
+
+def test_a_server_that_never_answers_times_out_with_a_clear_error(monkeypatch, tmp_path):
+    import socket
+    import time
+
+    from roto.sweep import storage
+
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)  # accepts connections, never answers
+    monkeypatch.setattr(storage, "CONNECT_TIMEOUT_S", 2)
+    url = f"postgresql://roto:s3cret@127.0.0.1:{listener.getsockname()[1]}/db"
+    start = time.monotonic()
+    with pytest.raises(ValueError, match=r"cannot open the storage 'postgresql://roto:\*\*\*@127.0.0.1:.*timeout"):
+        storage.open_storage(tmp_path, url)
+    assert time.monotonic() - start < 10
+    listener.close()
