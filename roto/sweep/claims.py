@@ -8,6 +8,7 @@ up. ``launch_workers`` starts worker processes of a ``roto`` subcommand here.
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 import time
@@ -70,13 +71,29 @@ def fail_and_retry(study: optuna.Study, storage: optuna.storages.BaseStorage, tr
 
 
 def launch_workers(command: str, count: int, argv: Sequence[str]) -> int:
-    """Run ``count`` ``roto <command> <argv> --workers 1`` processes here; the worst exit code.
+    """Run ``count`` ``roto <command> <argv> --workers 1`` processes here; 0 when every worker
+    succeeded, else the first failing worker's exit code (1 for a worker killed by a signal), each
+    failure named on stderr.
 
     Ctrl-C reaches every worker (one process group); each fails and re-enqueues its running trial.
     """
     line = [sys.executable, "-m", "roto.cli", command, *argv, "--workers", "1"]
     processes = [subprocess.Popen(line) for _ in range(count)]
     try:
-        return max(p.wait() for p in processes)
+        codes = [p.wait() for p in processes]
     except KeyboardInterrupt:
-        return max(p.wait() for p in processes)
+        codes = [p.wait() for p in processes]
+    return worst_exit(codes, [p.pid for p in processes])
+
+
+def worst_exit(codes: Sequence[int], pids: Sequence[int]) -> int:
+    """The command's exit code from its workers' (``Popen.returncode``: negative for a signal),
+    naming every failed worker on stderr."""
+    failed = [(k, pid, code) for k, (pid, code) in enumerate(zip(pids, codes, strict=True)) if code != 0]
+    for k, pid, code in failed:
+        how = f"was killed by {signal.Signals(-code).name}" if code < 0 else f"exited with {code}"
+        print(f"roto: worker {k + 1} of {len(codes)} (pid {pid}) {how}", file=sys.stderr)
+    if not failed:
+        return 0
+    code = failed[0][2]
+    return code if code > 0 else 1

@@ -62,3 +62,14 @@ def test_a_server_that_never_answers_times_out_with_a_clear_error(monkeypatch, t
         storage.open_storage(tmp_path, url)
     assert time.monotonic() - start < 10
     listener.close()
+
+
+def test_a_worker_killed_by_a_signal_fails_the_command_and_is_named(capsys):
+    from roto.sweep.claims import worst_exit
+
+    assert worst_exit([0, 0], [11, 12]) == 0 and capsys.readouterr().err == ""
+    assert worst_exit([0, -9], [11, 12]) == 1
+    assert "worker 2 of 2 (pid 12) was killed by SIGKILL" in capsys.readouterr().err
+    assert worst_exit([2, -15, 0], [1, 2, 3]) == 2
+    err = capsys.readouterr().err
+    assert "worker 1 of 3 (pid 1) exited with 2" in err and "worker 2 of 3 (pid 2) was killed by SIGTERM" in err
