@@ -56,6 +56,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     import torch
 
     from roto.sweep.claims import launch_workers
+    from roto.sweep.space import load_space
     from roto.sweep.study import SweepSettings, open_study
     from roto.sweep.worker import run_worker
 
@@ -66,6 +67,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.workers > 1:
+        load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)  # before creating
         open_study(settings)  # create it once, so the workers only join
         return launch_workers("sweep", args.workers, _worker_argv(args))
     torch.set_num_threads(args.torch_threads)

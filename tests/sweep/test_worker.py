@@ -190,3 +190,26 @@ def test_cli_workers_run_a_study_on_the_real_env_and_show_it(tmp_path, capsys):
     out = capsys.readouterr().out
     head = "| trial | state | best eval return | seed | env steps | minutes | env.action_smoothing | ppo.epochs |"
     assert head in out and "| ppo.lr | reason |" in out
+
+
+def test_a_bad_space_with_several_workers_is_refused_before_the_study_exists(tmp_path, capsys):
+    from roto.cli import main
+
+    space = tmp_path / "bad_space.yaml"
+    space.write_text("ppo:\n  no_such_key: {low: 1, high: 2}\n")
+    args = [
+        "sweep",
+        "--study",
+        "bad",
+        "--root",
+        str(tmp_path),
+        "--space",
+        str(space),
+        "--trials",
+        "2",
+        "--workers",
+        "2",
+    ]
+    assert main(args) == 2
+    assert "unknown sections ['ppo']" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()  # no study folder, no journal
