@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import pathlib
 import time
+import warnings
 from typing import Any
 
 import torch
@@ -67,15 +68,31 @@ class PolicyEvaluator:
         return record
 
     def drop_after(self, update: int) -> None:
-        """Forget records of updates after ``update`` (a resumed run repeats them)."""
+        """Forget records of updates after ``update`` (a resumed run repeats them), and a torn last
+        line; written atomically."""
         if self.path.is_file():
-            kept = [line for line in self.path.read_text().splitlines() if json.loads(line)["update"] <= update]
-            self.path.write_text("".join(line + "\n" for line in kept))
+            kept = [json.dumps(r) for r in read_evaluation_records(self.path) if r["update"] <= update]
+            temporary = self.path.with_suffix(".jsonl.tmp")
+            temporary.write_text("".join(line + "\n" for line in kept))
+            temporary.replace(self.path)
+
+
+def read_evaluation_records(path: pathlib.Path) -> list[dict[str, Any]]:
+    """The records of an ``evaluations.jsonl``. A torn last line (a crash mid-write) is skipped with a
+    warning; a broken line before it is a ValueError naming the file and the line."""
+    lines = [line for line in path.read_text().splitlines() if line.strip()]
+    records = []
+    for number, line in enumerate(lines, start=1):
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError:
+            if number < len(lines):
+                raise ValueError(f"{str(path)!r} line {number} is not a JSON record: {line[:80]!r}") from None
+            warnings.warn(f"{str(path)!r}: skipped a torn last line (a write cut off): {line[:80]!r}", stacklevel=2)
+    return records
 
 
 def read_evaluations(run_dir: str | pathlib.Path) -> list[dict[str, Any]]:
     """Every record of ``<run_dir>/evaluations.jsonl`` (empty if there is none)."""
     path = pathlib.Path(run_dir) / EVALUATIONS_NAME
-    if not path.is_file():
-        return []
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    return read_evaluation_records(path) if path.is_file() else []
