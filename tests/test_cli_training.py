@@ -201,3 +201,20 @@ def test_eval_into_a_missing_directory_fails_before_evaluating(trained_run, tmp_
 def test_zero_torch_threads_is_a_clear_error(capsys):
     assert main(["train", "--steps", "16", "--torch_threads", "0"]) == 2
     assert "--torch_threads must be an integer >= 1, got 0" in capsys.readouterr().err
+
+
+def test_a_resume_after_a_crash_logs_each_update_once(tmp_path, capsys):
+    """Updates logged after the checkpoint a run resumes from are run again: the CSV keeps one row
+    per (update, tag), not two."""
+    import csv
+    import shutil
+
+    run_dir = tmp_path / "run"
+    assert main(["train", "--num_envs", "4", "--steps", "48", "--run_dir", str(run_dir), "--no_progress", *TINY]) == 0
+    ckpts = run_dir / "checkpoints"
+    shutil.copy(ckpts / "agent_2.pt", ckpts / "latest.pt")  # as if it crashed before update 3's checkpoint
+    assert main(["train", "--resume", str(run_dir), "--steps", "64", "--no_progress"]) == 0
+    with (run_dir / "scalars.csv").open(newline="") as f:
+        rows = list(csv.reader(f))[1:]
+    keys = [(row[1], row[2]) for row in rows]
+    assert len(keys) == len(set(keys)) and {int(u) for u, _ in keys} == {1, 2, 3, 4}

@@ -12,13 +12,24 @@ CSV_NAME = "scalars.csv"
 class ScalarLogger:
     """Write every scalar to ``<run_dir>/scalars.csv`` (env_steps, update, tag, value), TensorBoard and W&B.
 
-    The CSV is appended to, so a resumed run continues the same file. ``wandb_run`` (from
-    ``roto.rl.wandb_run.open_wandb_run``) gets the same scalars at the same env steps and is
+    The CSV is appended to, so a resumed run continues the same file; rows of updates after
+    ``update`` (the checkpoint resumed from, whose updates are run again) are dropped first, and
+    TensorBoard hides its events after ``env_steps``, so each update is logged once. ``wandb_run``
+    (from ``roto.rl.wandb_run.open_wandb_run``) gets the same scalars at the same env steps and is
     finished on close.
     """
 
-    def __init__(self, run_dir: pathlib.Path, tensorboard: bool = True, wandb_run: Any | None = None) -> None:
+    def __init__(
+        self,
+        run_dir: pathlib.Path,
+        tensorboard: bool = True,
+        wandb_run: Any | None = None,
+        update: int = 0,
+        env_steps: int = 0,
+    ) -> None:
         self.path = run_dir / CSV_NAME
+        if self.path.exists():
+            drop_rows_after(self.path, update)
         new = not self.path.exists()
         self._file = self.path.open("a", newline="")
         self._csv = csv.writer(self._file)
@@ -28,7 +39,8 @@ class ScalarLogger:
         if tensorboard:
             from tensorboardX import SummaryWriter
 
-            self._tb = SummaryWriter(str(run_dir / "tensorboard"))
+            # events after the checkpoint's env steps are run again: hidden, not shown twice
+            self._tb = SummaryWriter(str(run_dir / "tensorboard"), purge_step=env_steps + 1 if update else None)
         self._wandb = wandb_run
 
     def log(self, scalars: dict[str, float], env_steps: int, update: int) -> None:
@@ -48,3 +60,20 @@ class ScalarLogger:
             self._tb.close()
         if self._wandb is not None:
             self._wandb.finish()
+
+
+def drop_rows_after(path: pathlib.Path, update: int) -> None:
+    """Rewrite the CSV at ``path`` (atomically) without the rows of updates after ``update``, and
+    without a torn last row."""
+    with path.open(newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        return
+    header, body = rows[0], rows[1:]
+    kept = [row for row in body if len(row) == len(header) and row[1].isdigit() and int(row[1]) <= update]
+    if len(kept) == len(body):
+        return
+    temporary = path.with_suffix(".csv.tmp")
+    with temporary.open("w", newline="") as f:
+        csv.writer(f).writerows([header, *kept])
+    temporary.replace(path)

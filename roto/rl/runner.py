@@ -176,7 +176,7 @@ class Trainer:
         wandb_run = None
         if self.wandb_project is not None:
             wandb_run = open_wandb_run(self.run_dir, self.wandb_project, run_config(self.settings, self.agent))
-        return ScalarLogger(self.run_dir, tensorboard=self.tensorboard, wandb_run=wandb_run)
+        return ScalarLogger(self.run_dir, self.tensorboard, wandb_run, update=self.update, env_steps=self.env_steps)
 
     def _collect_rollout(self) -> dict[str, float]:
         """``rollouts`` steps of every training env into the learner's buffer; timings."""
