@@ -23,6 +23,7 @@ from roto.rl.config import AgentConfig, from_dict, to_dict
 from roto.rl.evaluation import PolicyEvaluator
 from roto.rl.logger import ScalarLogger
 from roto.rl.networks import ActorCritic
+from roto.rl.run_lock import hold_run_lock
 from roto.rl.settings import TrainSettings, read_run_config, run_config, write_run_config
 from roto.rl.torch_threads import single_torch_thread
 from roto.rl.wandb_run import logged_wandb_project, open_wandb_run, require_wandb
@@ -89,6 +90,7 @@ class Trainer:
         self.run_dir = pathlib.Path(run_dir)
         extra = extra_groups(agent, settings.env.obs_mode)  # checks the groups before anything is built
         (self.run_dir / CHECKPOINT_DIR).mkdir(parents=True, exist_ok=True)
+        self._lock = hold_run_lock(self.run_dir)  # held from here until train() returns
         self.env = env_factory(settings.env_config(extra_groups=extra))
         self.device = self.env.device  # the policy learns where the envs simulate
         num_eval = agent.run.num_eval_envs_gpu if self.device.type == "cuda" else agent.run.num_eval_envs
@@ -133,6 +135,8 @@ class Trainer:
         ``on_update(trainer, scalars)`` runs after each update is logged and checkpointed (a sweep
         reports evaluations and stops diverged or pruned trials from it by raising).
         """
+        if self._lock is None:
+            self._lock = hold_run_lock(self.run_dir)
         if self.obs is None:
             self.obs, _ = self.env.reset(seed=self.settings.env.seed)
         logger = self._open_logger()
@@ -165,6 +169,9 @@ class Trainer:
         finally:
             bar.close()
             logger.close()
+            if self._lock is not None:  # the run is free for a resume once training stops
+                self._lock.close()
+                self._lock = None
         if self.tensorboard:
             from roto.eval.plots import plot_learning_curve
 

@@ -170,3 +170,15 @@ def test_best_checkpoint_holds_exactly_the_weights_of_the_best_evaluation(tmp_pa
     trainer.model.load_state_dict(state["model"])
     again = trainer.evaluator.evaluate(trainer.model, update=-1)
     assert again["per_episode"]["return"] == best["per_episode"]["return"]
+
+
+def test_one_run_directory_serves_one_trainer_at_a_time(tmp_path):
+    import os
+
+    first = tiny_trainer(tmp_path, "run", 1)
+    with pytest.raises(ValueError, match=rf"run '.*run' is in use by process {os.getpid()}"):
+        tiny_trainer(tmp_path, "run", 1)
+    first.train(progress=False)  # done: the run is free again
+    resumed = Trainer.resume(tmp_path / "run", total_steps=32, tensorboard=False)
+    resumed.train(progress=False)
+    assert resumed.update == 2
