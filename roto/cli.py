@@ -199,10 +199,26 @@ def _cmd_play(args: argparse.Namespace) -> int:
     from roto.eval.video import record_video
     from roto.rl.runner import load_policy
 
+    check_output_file(args.video, "--video")
     model, settings, _ = load_policy(args.checkpoint)
     result = record_video(model, settings, args.video, steps=args.video_length, seed=args.seed)
     print(json.dumps({"video": str(args.video), **result}))
     return 0
+
+
+def check_output_file(path: str, flag: str) -> None:
+    """Refuse, before any work, an output path that cannot be written as a file."""
+    import os
+    import pathlib
+
+    out = pathlib.Path(path)
+    if out.is_dir():
+        raise ValueError(f"{flag} {path!r} is a directory; give a file path, e.g. {str(out / 'play.mp4')!r}")
+    if not out.parent.is_dir():
+        what = "is not a directory" if out.parent.exists() else "does not exist"
+        raise ValueError(f"{flag} {path!r}: {str(out.parent)!r} {what}")
+    if not os.access(out.parent, os.W_OK):
+        raise PermissionError(f"{flag} {path!r}: directory {str(out.parent)!r} is not writable")
 
 
 def _cmd_render(args: argparse.Namespace) -> int:
@@ -337,6 +353,9 @@ def _add_demo_parser(sub: argparse._SubParsersAction) -> None:
 def build_parser() -> argparse.ArgumentParser:
     """The ``roto`` argument parser."""
     parser = argparse.ArgumentParser(prog="roto", description="roto: the Robot Tactile Olympiad on MuJoCo")
+    parser.add_argument(
+        "--debug", action="store_true", help="show the full traceback of an error instead of its one-line message"
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     # the order here is the order ``roto --help`` lists the subcommands in
     for add in (
@@ -359,9 +378,31 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
-    except (ValueError, TypeError, FileNotFoundError, KeyError) as error:
-        print(f"roto {args.command}: error: {error}", file=sys.stderr)
-        return 2
+    except Exception as error:
+        if args.debug:
+            raise
+        code, kind = error_exit(error)
+        if code is None:
+            raise
+        print(f"roto {args.command}: {kind}: {error}", file=sys.stderr)
+        return code
+
+
+BAD_PATH_ERRORS = (FileNotFoundError, FileExistsError, IsADirectoryError, NotADirectoryError, PermissionError)
+
+
+def error_exit(error: Exception) -> tuple[int | None, str]:
+    """(exit code, word) for an expected failure: 2 "error" for bad input (a bad value, name or
+    path), 1 "failed" for a failure while running (out of memory, an OS or database error); (None,
+    "") for an unexpected one, which keeps its traceback (a bug to report)."""
+    if isinstance(error, (ValueError, TypeError, KeyError, *BAD_PATH_ERRORS)):
+        return 2, "error"
+    if isinstance(error, (OSError, MemoryError)):
+        return 1, "failed"
+    module = type(error).__module__.split(".")[0]
+    if module in ("sqlalchemy", "optuna", "psycopg2", "psycopg"):
+        return 1, "failed"
+    return None, ""
 
 
 if __name__ == "__main__":

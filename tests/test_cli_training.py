@@ -218,3 +218,27 @@ def test_a_resume_after_a_crash_logs_each_update_once(tmp_path, capsys):
         rows = list(csv.reader(f))[1:]
     keys = [(row[1], row[2]) for row in rows]
     assert len(keys) == len(set(keys)) and {int(u) for u, _ in keys} == {1, 2, 3, 4}
+
+
+@pytest.mark.parametrize("where", ["a_directory", "under_a_file"])
+def test_play_to_a_path_that_cannot_be_a_video_is_one_line(trained_run, tmp_path, capsys, where):
+    target = tmp_path
+    if where == "under_a_file":
+        (tmp_path / "file").write_text("x")
+        target = tmp_path / "file" / "video.mp4"
+    args = ["play", "--checkpoint", str(trained_run / "checkpoints" / "latest.pt"), "--video", str(target)]
+    assert main([*args, "--video_length", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("roto play: error:") and len(err.strip().splitlines()) == 1
+    with pytest.raises(ValueError):  # --debug shows the traceback instead
+        main(["--debug", *args, "--video_length", "2"])
+
+
+def test_runtime_failures_exit_1_and_unexpected_errors_keep_their_traceback():
+    from roto.cli import error_exit
+
+    assert error_exit(MemoryError("out of memory")) == (1, "failed")
+    assert error_exit(ConnectionResetError("peer")) == (1, "failed")
+    assert error_exit(PermissionError("denied")) == (2, "error")
+    assert error_exit(ValueError("bad")) == (2, "error")
+    assert error_exit(ZeroDivisionError()) == (None, "")
