@@ -8,6 +8,7 @@ import json
 import sys
 from collections.abc import Sequence
 
+from roto.cli_errors import check_output_file, error_exit
 from roto.olympiad.command import add_olympiad_parsers
 from roto.sweep.command import add_sweep_parser
 
@@ -206,21 +207,6 @@ def _cmd_play(args: argparse.Namespace) -> int:
     return 0
 
 
-def check_output_file(path: str, flag: str) -> None:
-    """Refuse, before any work, an output path that cannot be written as a file."""
-    import os
-    import pathlib
-
-    out = pathlib.Path(path)
-    if out.is_dir():
-        raise ValueError(f"{flag} {path!r} is a directory; give a file path, e.g. {str(out / 'play.mp4')!r}")
-    if not out.parent.is_dir():
-        what = "is not a directory" if out.parent.exists() else "does not exist"
-        raise ValueError(f"{flag} {path!r}: {str(out.parent)!r} {what}")
-    if not os.access(out.parent, os.W_OK):
-        raise PermissionError(f"{flag} {path!r}: directory {str(out.parent)!r} is not writable")
-
-
 def _cmd_render(args: argparse.Namespace) -> int:
     from roto.eval.video import render_scene
 
@@ -386,23 +372,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         print(f"roto {args.command}: {kind}: {error}", file=sys.stderr)
         return code
-
-
-BAD_PATH_ERRORS = (FileNotFoundError, FileExistsError, IsADirectoryError, NotADirectoryError, PermissionError)
-
-
-def error_exit(error: Exception) -> tuple[int | None, str]:
-    """(exit code, word) for an expected failure: 2 "error" for bad input (a bad value, name or
-    path), 1 "failed" for a failure while running (out of memory, an OS or database error); (None,
-    "") for an unexpected one, which keeps its traceback (a bug to report)."""
-    if isinstance(error, (ValueError, TypeError, KeyError, *BAD_PATH_ERRORS)):
-        return 2, "error"
-    if isinstance(error, (OSError, MemoryError)):
-        return 1, "failed"
-    module = type(error).__module__.split(".")[0]
-    if module in ("sqlalchemy", "optuna", "psycopg2", "psycopg"):
-        return 1, "failed"
-    return None, ""
 
 
 if __name__ == "__main__":

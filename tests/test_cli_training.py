@@ -232,13 +232,3 @@ def test_play_to_a_path_that_cannot_be_a_video_is_one_line(trained_run, tmp_path
     assert err.startswith("roto play: error:") and len(err.strip().splitlines()) == 1
     with pytest.raises(ValueError):  # --debug shows the traceback instead
         main(["--debug", *args, "--video_length", "2"])
-
-
-def test_runtime_failures_exit_1_and_unexpected_errors_keep_their_traceback():
-    from roto.cli import error_exit
-
-    assert error_exit(MemoryError("out of memory")) == (1, "failed")
-    assert error_exit(ConnectionResetError("peer")) == (1, "failed")
-    assert error_exit(PermissionError("denied")) == (2, "error")
-    assert error_exit(ValueError("bad")) == (2, "error")
-    assert error_exit(ZeroDivisionError()) == (None, "")
