@@ -68,6 +68,7 @@ def build_model(sizes: Mapping[str, int], num_actions: int, agent: AgentConfig, 
         policy_head=net.policy_head,
         value_head=net.value_head,
         init_log_std=net.init_log_std,
+        max_log_std=net.max_log_std,
         obs_normalization=net.obs_normalization,
     )
 

@@ -32,6 +32,10 @@ class NetworkConfig:
     policy_head: tuple[int, ...] = (128, 64)
     value_head: tuple[int, ...] = (128, 64)
     init_log_std: float = 0.0
+    max_log_std: float = 2.0
+    """Upper bound of the policy's log standard deviation (roto's clamp: 2, a std of 7.4 in action
+    units of ±1). A lower bound keeps a small batch's sampled actions near the mean action
+    evaluation uses (0: a std of at most 1)."""
     obs_normalization: bool = True
     """Standardise each network's input with running statistics kept in the model (clip ±5)."""
     actor: tuple[str, ...] | None = None

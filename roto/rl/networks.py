@@ -79,6 +79,7 @@ class ActorCritic(nn.Module):
         encoder: hidden sizes of the encoder(s).
         policy_head, value_head: hidden sizes of the heads (Linear -> ELU), then a linear output.
         init_log_std: initial log standard deviation of every action dimension.
+        max_log_std: upper bound of the log standard deviation (clamped in the forward pass).
         obs_normalization: standardise each encoder's input with running statistics kept here.
     """
 
@@ -93,6 +94,7 @@ class ActorCritic(nn.Module):
         policy_head: Sequence[int] = (128, 64),
         value_head: Sequence[int] = (128, 64),
         init_log_std: float = 0.0,
+        max_log_std: float = LOG_STD_MAX,
         obs_normalization: bool = True,
     ) -> None:
         super().__init__()
@@ -101,6 +103,9 @@ class ActorCritic(nn.Module):
         self.latent_width = encoder[-1] if encoder else self.actor_input.width
         self.policy_body = mlp([self.latent_width, *policy_head], layer_norm=False)
         self.policy_mean = nn.Linear(policy_head[-1] if policy_head else self.latent_width, num_actions)
+        if not max_log_std > LOG_STD_MIN:
+            raise ValueError(f"network.max_log_std must be above {LOG_STD_MIN}, got {max_log_std}")
+        self.max_log_std = float(max_log_std)
         self.log_std = nn.Parameter(torch.full((num_actions,), float(init_log_std)))
         self.critic_input: GroupInput | None = None
         self.critic_encoder: nn.Sequential | None = None
@@ -132,11 +137,15 @@ class ActorCritic(nn.Module):
             latent = self.encode(obs)
         return self.value_out(self.value_body(latent)).squeeze(-1)
 
+    def clamped_log_std(self) -> torch.Tensor:
+        """(n,) the policy's log standard deviation within [LOG_STD_MIN, max_log_std]."""
+        return self.log_std.clamp(LOG_STD_MIN, self.max_log_std)
+
     def forward(self, obs: Obs) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
         """(action mean (N, n), log-std (n,), value (N,), actor latent (N, W))."""
         z = self.encode(obs)
         mean = self.policy_mean(self.policy_body(z))
-        return mean, self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX), self.value(obs, z), z
+        return mean, self.clamped_log_std(), self.value(obs, z), z
 
     @torch.no_grad()
     def act_deterministic(self, obs: Obs) -> torch.Tensor:

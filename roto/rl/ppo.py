@@ -164,7 +164,7 @@ class PPO:
                 self._adapt_lr(float(torch.stack(epoch_kl).mean()))
         out = {name: float(total / counts[name]) for name, total in sums.items()}
         out["ppo/explained_variance"] = float(explained_variance(buffer.values, buffer.returns))
-        out["ppo/action_std"] = float(self.model.log_std.detach().clamp(-20, 2).exp().mean())
+        out["ppo/action_std"] = float(self.model.clamped_log_std().detach().exp().mean())
         out["ppo/lr"] = self.lr
         self.model.update_normalizers(buffer.flat_obs())
         buffer.clear()

@@ -83,3 +83,24 @@ def test_aux_epochs_follow_roto_rule():
 
     assert [aux_epochs(10, r) for r in (0.25, 0.5, 1.0, 0.01)] == [2, 5, 10, 1]
     assert aux_epochs(7, 0.75) == 5
+
+
+def test_max_log_std_bounds_the_policy_std():
+    import math
+
+    import torch
+
+    from roto.rl.build import build_model
+
+    agent = load_agent_config("bounce", overrides=["network.max_log_std=0.0", "network.encoder=[8]"])
+    model = build_model({"tactile": 4, "proprio": 8}, 3, agent, "blind")
+    with torch.no_grad():
+        model.log_std.fill_(1.5)  # as a growing entropy bonus would push it
+    _, log_std, _, _ = model({"tactile": torch.zeros(2, 4), "proprio": torch.zeros(2, 8)})
+    assert torch.equal(log_std, torch.zeros(3)) and math.isclose(float(model.clamped_log_std().exp()[0]), 1.0)
+    roto_default = build_model({"tactile": 4, "proprio": 8}, 3, load_agent_config("bounce"), "blind")
+    assert roto_default.max_log_std == 2.0
+    with pytest.raises(ValueError, match=r"network.max_log_std must be above -20.0, got -30"):
+        build_model(
+            {"tactile": 4, "proprio": 8}, 3, load_agent_config("bounce", overrides=["network.max_log_std=-30"]), "blind"
+        )
