@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.util
-import pathlib
 from dataclasses import dataclass
 
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, TOUCH_MODES
@@ -112,8 +111,6 @@ class EnvConfig:
             raise ValueError(f"replay_share must be a number in [0, 1], got {share!r}")
         if share > 0.0 and self.replay_starts is None:
             raise ValueError(f"replay_share {share} needs replay_starts (an .npz of recorded states); got none")
-        if self.replay_starts is not None and not pathlib.Path(self.replay_starts).is_file():
-            raise ValueError(f"replay_starts {str(self.replay_starts)!r} is not a file")
 
     def _check_device(self) -> None:
         device = str(self.device)

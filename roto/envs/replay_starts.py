@@ -10,6 +10,7 @@ instead of the task's own starts; evaluation never does.
 from __future__ import annotations
 
 import dataclasses
+import pathlib
 from dataclasses import dataclass
 
 import mujoco
@@ -61,8 +62,11 @@ def load_replay_bank(path: str, model: mujoco.MjModel, robot: str, task_state: o
     arrays named like a field of ``task_state``.
 
     Raises:
-        ValueError naming the file when it is of another robot, another model or holds no state.
+        ValueError naming the file when it is missing, of another robot, of another model or holds
+        no state.
     """
+    if not pathlib.Path(path).is_file():  # checked here, where it is read: a run's config stays loadable without it
+        raise ValueError(f"replay_starts {str(path)!r} is not a file")
     with np.load(path, allow_pickle=False) as saved:
         arrays = {name: saved[name] for name in saved.files}
     if "robot" in arrays and str(arrays["robot"]) != robot:

@@ -101,12 +101,23 @@ def test_evaluation_envs_never_replay():
     [
         ({"replay_share": 1.5, "replay_starts": BANK}, r"replay_share must be a number in \[0, 1\], got 1.5"),
         ({"replay_share": 0.5}, r"replay_share 0.5 needs replay_starts"),
-        ({"replay_starts": "/nowhere/states.npz"}, r"replay_starts '/nowhere/states.npz' is not a file"),
     ],
 )
 def test_bad_replay_settings_are_refused(kwargs, pattern):
     with pytest.raises(ValueError, match=pattern):
         EnvConfig(task="baoding", **kwargs)
+
+
+def test_a_missing_states_file_is_refused_by_the_env_and_a_run_s_config_still_loads():
+    with pytest.raises(ValueError, match=r"replay_starts '/nowhere/states.npz' is not a file"):
+        roto.make("baoding", replay_starts="/nowhere/states.npz", replay_share=0.5)
+    # a run trained with the aid is still evaluated where the file is gone (eval drops the aid)
+    settings = TrainSettings.from_dict(
+        {"env": {"task": "baoding", "replay_starts": "/nowhere/states.npz", "replay_share": 0.5}, "total_steps": 10}
+    )
+    env = roto.make(**vars(settings.eval_env_config(num_envs=1)))
+    assert env.replay_bank is None
+    env.close()
 
 
 def test_states_of_another_hand_are_refused():
