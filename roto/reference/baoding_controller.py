@@ -123,13 +123,15 @@ def _cost(
     )
 
 
-def reference_env(robot: str, seed: int, episode_steps: int = 600) -> RotoEnv:
-    """The one-world Baoding env the reference controller plays (benchmark settings)."""
-    return make("baoding", robot=robot, num_envs=1, seed=seed, obs_mode="blind", episode_steps=episode_steps)
+def reference_env(robot: str, seed: int, episode_steps: int = 600, **options: object) -> RotoEnv:
+    """The one-world Baoding env the reference controller plays (benchmark settings, unless
+    ``options`` change them: e.g. ``replay_starts`` to start from recorded states)."""
+    return make("baoding", robot=robot, num_envs=1, seed=seed, obs_mode="blind", episode_steps=episode_steps, **options)
 
 
 def save_preswap_states(path, robot: str, states: PreswapStates) -> None:
-    """Write the pre-swap states to an ``.npz`` (arrays named as ``PreswapStates``' fields)."""
+    """Write the pre-swap states to an ``.npz`` (arrays named as ``PreswapStates``' fields), the
+    format an env's ``replay_starts`` reads (``roto.envs.replay_starts``)."""
     np.savez_compressed(
         path,
         robot=np.array(robot),
@@ -139,24 +141,6 @@ def save_preswap_states(path, robot: str, states: PreswapStates) -> None:
         swapped=np.array(states.swapped, dtype=bool),
         latched=np.array(states.latched, dtype=bool).reshape(-1, 2),
     )
-
-
-def load_preswap_states(path) -> dict[str, np.ndarray]:
-    """The arrays ``save_preswap_states`` wrote: physics (n, nstate), target (n, nu), swapped (n,),
-    latched (n, 2), robot and lead_steps."""
-    with np.load(path, allow_pickle=False) as saved:
-        return {name: saved[name] for name in saved.files}
-
-
-def restore_preswap_state(env: RotoEnv, states: dict[str, np.ndarray], k: int) -> None:
-    """Put the one-world ``env`` into pre-swap state ``k``: its physics, joint targets, latches and
-    assignment (the episode's counters and frames are left as they are)."""
-    if str(states["robot"]) != env.robot.name:
-        raise ValueError(f"pre-swap states of robot {str(states['robot'])!r} do not fit an env of {env.robot.name!r}")
-    env.backend.load_physics_state(states["physics"][k : k + 1])
-    env._target[0] = torch.from_numpy(states["target"][k])
-    env.task_state.swapped[0] = bool(states["swapped"][k])
-    env.task_state.latched[0] = torch.from_numpy(states["latched"][k])
 
 
 def run_reference_baoding(

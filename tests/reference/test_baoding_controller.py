@@ -5,18 +5,14 @@ import pathlib
 
 import numpy as np
 import pytest
+import torch
 
-from roto.reference.baoding_controller import (
-    BaodingReference,
-    load_preswap_states,
-    reference_env,
-    restore_preswap_state,
-)
+from roto.reference.baoding_controller import BaodingReference, reference_env
 from roto.reference.baoding_cost import BaodingCostWeights
 from roto.reference.predictive_sampling import PredictiveSampling, SamplingConfig
 from roto.registry import make
 
-RESULTS = pathlib.Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "baoding_reference"
+PRESWAP = pathlib.Path(__file__).resolve().parents[2] / "benchmarks/results/baoding_reference/shadow_preswap.npz"
 
 
 def controller_for(env, seed: int = 0) -> BaodingReference:
@@ -25,17 +21,18 @@ def controller_for(env, seed: int = 0) -> BaodingReference:
     return BaodingReference(env, planner, BaodingCostWeights())
 
 
-@pytest.mark.parametrize("k", [0, 5])
-def test_from_a_recorded_preswap_state_the_controller_swaps_again(k):
+@pytest.mark.parametrize("seed", [0, 5])
+def test_from_a_recorded_preswap_state_the_controller_swaps_again(seed):
     """The recorded states fit the Shadow's scene and lead to a swap within a few tenths of a second
-    (recorded 10 control steps before one), with a planner seeded afresh."""
-    states = load_preswap_states(RESULTS / "shadow_preswap.npz")
-    assert int(states["lead_steps"]) == 10 and len(states["physics"]) >= 100
-    env = reference_env("shadow", seed=0)
+    (recorded 10 control steps before one), with a planner seeded afresh. The env starts in one of
+    them through its own replayed starts."""
+    with np.load(PRESWAP) as saved:
+        assert int(saved["lead_steps"]) == 10 and len(saved["physics"]) >= 100
+    env = reference_env("shadow", seed=seed, replay_starts=str(PRESWAP), replay_share=1.0)
     env.reset()
+    physics = torch.from_numpy(env.backend.physics_state()[0, 1 : 1 + env.model.nq])
+    assert (env.replay_bank.qpos == physics).all(dim=1).any()  # a recorded state, exactly
     controller = controller_for(env)
-    restore_preswap_state(env, states, k)
-    np.testing.assert_array_equal(env.backend.physics_state()[0], states["physics"][k])
     controller.start()
     swaps = 0
     for _ in range(40):
@@ -56,8 +53,5 @@ def test_the_controller_needs_one_world_on_the_cpu():
 
 
 def test_preswap_states_of_another_hand_are_refused():
-    states = load_preswap_states(RESULTS / "shadow_preswap.npz")
-    env = reference_env("allegro", seed=0)
-    with pytest.raises(ValueError, match="pre-swap states of robot 'shadow' do not fit an env of 'allegro'"):
-        restore_preswap_state(env, states, 0)
-    env.close()
+    with pytest.raises(ValueError, match="states of robot 'shadow', not 'allegro'"):
+        reference_env("allegro", seed=0, replay_starts=str(PRESWAP), replay_share=1.0)
