@@ -30,11 +30,15 @@ DROP_SPACING = 0.04
 DROP_GAP = 0.001
 
 
+BALL_COLOURS = ((0.85, 0.65, 0.15), (0.2, 0.45, 0.85))
+"""RGB of ball a (gold) and ball b (blue); their targets are drawn in the same colours."""
+
+
 def baoding_balls(radius: float) -> tuple[BallSpec, ...]:
     """Two 55 g balls of the given radius (distinct colours)."""
-    return (
-        BallSpec(name="ball_a", radius=radius, mass=BALL_MASS, rgba=(0.85, 0.65, 0.15, 1.0)),
-        BallSpec(name="ball_b", radius=radius, mass=BALL_MASS, rgba=(0.2, 0.45, 0.85, 1.0)),
+    return tuple(
+        BallSpec(name=name, radius=radius, mass=BALL_MASS, rgba=(*rgb, 1.0))
+        for name, rgb in zip(("ball_a", "ball_b"), BALL_COLOURS, strict=True)
     )
 
 
@@ -183,6 +187,5 @@ class Baoding:
         """Each ball's current target, a translucent sphere of the success radius in the ball's colour."""
         current = self.observation(state)[:, :6].unflatten(1, (2, 3))
         return [
-            Marker(pos=current[:, i], radius=SUCCESS_RADIUS, rgba=(*ball.rgba[:3], 0.35))
-            for i, ball in enumerate(baoding_balls(0.0))
+            Marker(pos=current[:, i], radius=SUCCESS_RADIUS, rgba=(*rgb, 0.35)) for i, rgb in enumerate(BALL_COLOURS)
         ]
