@@ -89,6 +89,8 @@ class RotoEnv:
         self._last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
         self._zero_qvel = torch.zeros(self.num_envs, self.model.nv, dtype=torch.float64, device=self.device)
         self.replay_bank = self._load_replay_bank()
+        replaying = self.replay_bank is not None and config.replay_share > 0.0
+        self._replayed_task_fields = tuple(self.replay_bank.task) if replaying else ()
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
@@ -333,11 +335,10 @@ class RotoEnv:
         rows = done[:, None]
         self.backend.set_state_where(done, start["qpos"], start.get("qvel", self._zero_qvel))
         self.task.reset(self.task_state, done)
-        for key, recorded in start.items():  # the task state a replayed start was recorded in
-            if key.startswith("task/"):
-                field = getattr(self.task_state, key[5:])
-                where = done.view(-1, *[1] * (field.dim() - 1))
-                setattr(self.task_state, key[5:], torch.where(where, recorded.to(field.dtype), field))
+        for name in self._replayed_task_fields:  # the task state a replayed start was recorded in
+            field = getattr(self.task_state, name)
+            where = done.view(-1, *[1] * (field.dim() - 1))
+            setattr(self.task_state, name, torch.where(where, start[f"task/{name}"].to(field.dtype), field))
         self._target = torch.where(rows, start["target"], self._target)
         self._last_action.masked_fill_(rows, 0.0)
         self._episode.length.masked_fill_(done, 0)
