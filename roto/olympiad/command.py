@@ -20,6 +20,8 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--storage", default=None, help="database URL (e.g. postgresql://...); default: journal file")
     p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
     p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running cell's heartbeats")
+    p.add_argument("--reclaim-now", "--reclaim_now", dest="reclaim_now", action="store_true",
+                   help="first fail and retry every running cell (only when no other worker is alive)")  # fmt: skip
     p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
     p.add_argument("--dry-run", "--dry_run", dest="dry_run", action="store_true",
                    help="list the cells, which are done, and the time left; train nothing")  # fmt: skip
@@ -42,6 +44,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     from roto.olympiad.plan import load_plan
     from roto.olympiad.worker import enqueue_missing, open_olympiad, run_olympiad_worker
     from roto.sweep.claims import launch_workers
+    from roto.sweep.storage import reclaim_now
 
     plan = load_plan(args.plan)  # checked before anything runs or is written
     results = _results_dir(args, plan.name)
@@ -52,13 +55,16 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.workers > 1:
         # create the study and enqueue the cells once, so the workers only join and claim
-        enqueue_missing(open_olympiad(plan, args.root, args.storage)[0], plan, results)
+        study, storage = open_olympiad(plan, args.root, args.storage)
+        if args.reclaim_now:  # here, once: a worker reclaiming would take its siblings' fresh claims
+            reclaim_now(study, storage)
+        enqueue_missing(study, plan, results)
         argv = [args.plan, "--root", args.root, "--results", str(results), "--heartbeat", str(args.heartbeat),
                 "--torch_threads", str(args.torch_threads)]  # fmt: skip
         argv += ["--storage", args.storage] if args.storage else []
         return launch_workers("olympiad", args.workers, argv)
     torch.set_num_threads(args.torch_threads)
-    finished = run_olympiad_worker(plan, args.root, results, args.storage, args.heartbeat)
+    finished = run_olympiad_worker(plan, args.root, results, args.storage, args.heartbeat, reclaim=args.reclaim_now)
     print(json.dumps({"plan": plan.name, "finished_by_this_worker": finished, "results": str(results)}))
     return 0
 

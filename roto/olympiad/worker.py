@@ -3,7 +3,7 @@
 Each cell is a trial enqueued in the study ``olympiad-<plan>`` (the journal in ``<root>/<plan>``
 or a database, as for sweeps, ``roto.sweep.storage``), its name in the trial's ``cell`` user
 attribute. A worker enqueues every cell that has neither a summary nor a live trial, then claims
-waiting trials until none is left. A worker that dies leaves its trial without a
+waiting trials until none is waiting or running. A worker that dies leaves its trial without a
 heartbeat; the next worker to look fails it and enqueues a retry, which continues the cell's run
 from its latest checkpoint and is claimed before any fresh cell (so interrupted cells finish
 first, and a partial grid is as complete as it can be). Should a cell be enqueued twice (workers
@@ -25,7 +25,7 @@ from roto.envs.roto_env import RotoEnv
 from roto.olympiad.cell import code_commit, run_cell, summary_path
 from roto.olympiad.plan import Cell, Plan
 from roto.sweep.claims import run_claimed, tell_failed
-from roto.sweep.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage
+from roto.sweep.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 
 CELL_ATTR = "cell"
 LIVE = (TrialState.COMPLETE, TrialState.RUNNING, TrialState.WAITING)
@@ -90,18 +90,24 @@ def run_olympiad_worker(
     storage_url: str | None = None,
     heartbeat: float = 30.0,
     env_factory: Callable[[Any], Any] = RotoEnv,
+    reclaim: bool = False,
 ) -> int:
-    """Train cells until none is waiting; the number this worker finished."""
+    """Train cells until none is waiting or running; the number this worker finished.
+    ``reclaim``: first fail and retry every running cell (``--reclaim-now``)."""
     results = pathlib.Path(results) if results is not None else pathlib.Path(root) / plan.name / "results"
     study, storage = open_olympiad(plan, root, storage_url)
     enqueue_missing(study, plan, results)
     cells = {cell.name: cell for cell in plan.cells}
     commit = code_commit()  # the code this worker trains with, read before the checkout can move on
-    finished = 0
+    if reclaim:
+        reclaim_now(study, storage)
+    finished, told = 0, set()
     while True:
         fail_stale_trials(study, storage, grace=4 * heartbeat)
         trial = claim_next(study, storage)
         if trial is None:
+            if wait_for_running(study, heartbeat, told):  # a dead worker's cell comes back as a retry
+                continue
             return finished
         name = trial.user_attrs.get(CELL_ATTR)
         if name not in cells:

@@ -36,6 +36,8 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
     p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running trial's heartbeats")
     p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
+    p.add_argument("--reclaim-now", "--reclaim_now", dest="reclaim_now", action="store_true",
+                   help="first fail and retry every running trial (only when no other worker is alive)")  # fmt: skip
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="section.key=value",
                    help="override every trial gets (env.num_envs=64, ppo.gamma=0.99); repeatable")  # fmt: skip
     _study_args(p, required=False)
@@ -57,6 +59,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     from roto.sweep.claims import launch_workers
     from roto.sweep.space import load_space
+    from roto.sweep.storage import reclaim_now
     from roto.sweep.study import SweepSettings, open_study
     from roto.sweep.worker import run_worker
 
@@ -68,10 +71,12 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.workers > 1:
         load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)  # before creating
-        open_study(settings)  # create it once, so the workers only join
+        study, storage = open_study(settings)  # create it once, so the workers only join
+        if args.reclaim_now:  # here, once: a worker reclaiming would take its siblings' fresh claims
+            reclaim_now(study, storage)
         return launch_workers("sweep", args.workers, _worker_argv(args))
     torch.set_num_threads(args.torch_threads)
-    finished = run_worker(settings)
+    finished = run_worker(settings, reclaim=args.reclaim_now)
     print(json.dumps({"study": settings.study, "finished_by_this_worker": finished}))
     return 0
 

@@ -16,6 +16,7 @@ directory from its latest checkpoint. This works the same on the journal and on 
 from __future__ import annotations
 
 import importlib.util
+import math
 import pathlib
 import sys
 import threading
@@ -27,8 +28,11 @@ import optuna
 import sqlalchemy.exc
 from optuna.exceptions import UpdateFinishedTrialError
 from optuna.storages import RetryHeartbeatStaleTrialCallback
-from optuna.storages.journal import JournalFileBackend, JournalStorage
+from optuna.storages.journal import JournalStorage
 from optuna.trial import TrialState
+
+from roto.sweep.journal import JournalFile
+from roto.sweep.retrying_storage import RetryingStorage, first_line
 
 JOURNAL_NAME = "journal.log"
 HEARTBEAT_ATTR = "roto:heartbeat"
@@ -71,6 +75,9 @@ def database_url(url: str) -> str:
 def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.storages.BaseStorage:
     """The journal file in ``study_dir`` (created), or the database at ``url``.
 
+    A database storage retries calls across a lost connection (``RetryingStorage``); the journal
+    drops a torn last line before writing (``JournalFile``).
+
     Raises:
         ValueError naming the URL (password hidden) when the database cannot be reached in
         ``CONNECT_TIMEOUT_S`` or refuses the connection.
@@ -81,12 +88,12 @@ def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.stor
         if driver_url.startswith("postgresql"):
             engine["connect_args"] = {"connect_timeout": CONNECT_TIMEOUT_S}
         try:
-            return optuna.storages.RDBStorage(driver_url, engine_kwargs=engine)
+            database = optuna.storages.RDBStorage(driver_url, engine_kwargs=engine)
         except sqlalchemy.exc.SQLAlchemyError as error:
-            reason = str(getattr(error, "orig", None) or error).strip().splitlines()[0]
-            raise ValueError(f"cannot open the storage {redact_url(url)!r}: {reason}") from None
+            raise ValueError(f"cannot open the storage {redact_url(url)!r}: {first_line(error)}") from None
+        return RetryingStorage(database, redact_url(url))
     study_dir.mkdir(parents=True, exist_ok=True)
-    return JournalStorage(JournalFileBackend(str(study_dir / JOURNAL_NAME)))
+    return JournalStorage(JournalFile(str(study_dir / JOURNAL_NAME)))
 
 
 def find_study(folder: pathlib.Path, name: str, url: str | None = None) -> optuna.Study | None:
@@ -125,11 +132,14 @@ class Heartbeat:
                 print(f"heartbeat of trial id {self.trial_id} not written: {error}", file=sys.stderr, flush=True)
 
 
-def fail_stale_trials(study: optuna.Study, storage: optuna.storages.BaseStorage, grace: float) -> list[int]:
+def fail_stale_trials(
+    study: optuna.Study, storage: optuna.storages.BaseStorage, grace: float, why: str | None = None
+) -> list[int]:
     """Mark running trials without a heartbeat for ``grace`` s as failed and enqueue their retries.
 
-    Returns the numbers of the trials this call failed (another worker may fail the same trial at
-    the same time; the storage lets exactly one of them do it).
+    ``why``: the reason stored on each (default: how long it was silent). Returns the numbers of
+    the trials this call failed (another worker may fail the same trial at the same time; the
+    storage lets exactly one of them do it).
     """
     failed = []
     now = time.time()
@@ -138,7 +148,7 @@ def fail_stale_trials(study: optuna.Study, storage: optuna.storages.BaseStorage,
         if now - beat <= grace:
             continue
         try:
-            storage.set_trial_user_attr(trial._trial_id, REASON_ATTR, f"no heartbeat for {now - beat:.0f} s")
+            storage.set_trial_user_attr(trial._trial_id, REASON_ATTR, why or f"no heartbeat for {now - beat:.0f} s")
             if not storage.set_trial_state_values(trial._trial_id, TrialState.FAIL):
                 continue
         except UpdateFinishedTrialError:
@@ -146,3 +156,34 @@ def fail_stale_trials(study: optuna.Study, storage: optuna.storages.BaseStorage,
         enqueue_retry(study, storage.get_trial(trial._trial_id))
         failed.append(trial.number)
     return failed
+
+
+def reclaim_now(study: optuna.Study, storage: optuna.storages.BaseStorage) -> list[int]:
+    """Fail every running trial at once and enqueue its retry (``--reclaim-now``: the caller knows
+    their workers are dead); the numbers of the trials failed."""
+    failed = fail_stale_trials(study, storage, grace=-math.inf, why="reclaimed at once (--reclaim-now)")
+    if failed:
+        print(f"roto: reclaimed running trials {failed}: each is retried from its latest checkpoint", flush=True)
+    return failed
+
+
+def wait_for_running(study: optuna.Study, heartbeat: float, told: set[tuple[int, ...]]) -> bool:
+    """Whether trials still run; if so, wait one heartbeat (saying why, once per set of trials).
+
+    A worker with nothing left to claim waits here rather than stopping: a running trial either
+    finishes, or its worker has died and the trial is retried once its heartbeat is ``4 *
+    heartbeat`` s old, by whichever worker is still looking. ``told``: the sets already announced.
+    """
+    running = tuple(t.number for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)))
+    if not running:
+        return False
+    if running not in told:
+        told.add(running)
+        print(
+            f"roto: nothing left to claim; waiting for running trials {list(running)}. A trial whose worker died "
+            f"is retried here after {4 * heartbeat:.0f} s without a heartbeat (--reclaim-now retries every "
+            "running trial at once, when you know no other worker is alive)",
+            flush=True,
+        )
+    time.sleep(heartbeat)
+    return True

@@ -1,8 +1,9 @@
 """A sweep worker: claim a trial, train it, record it, until the study has its trials.
 
 Any number of workers, in any number of processes or machines, run this same loop on one study.
-Before each trial a worker fails and re-enqueues trials whose worker died (``storage``); it stops
-when the finished and running trials reach the study's count. Trial numbers come from the
+Before each trial a worker fails and re-enqueues trials whose worker died (``storage``). When the
+finished and running trials reach the study's count it waits for the running ones (one whose
+worker died comes back as a retry) and stops when none is left. Trial numbers come from the
 storage, so a trial that would exceed the count (two workers asking at once for the last one)
 is told failed at once, as surplus, and trains nothing.
 """
@@ -18,7 +19,7 @@ from optuna.trial import TrialState
 from roto.envs.roto_env import RotoEnv
 from roto.sweep.claims import run_claimed, tell_failed
 from roto.sweep.space import load_space
-from roto.sweep.storage import fail_stale_trials
+from roto.sweep.storage import fail_stale_trials, reclaim_now, wait_for_running
 from roto.sweep.study import SweepSettings, open_study
 from roto.sweep.trial import run_trial
 
@@ -34,14 +35,20 @@ def claimed_before(study: optuna.Study, number: int) -> int:
     return sum(t.number < number for t in study.get_trials(deepcopy=False, states=CLAIMED))
 
 
-def run_worker(settings: SweepSettings, env_factory: Callable[[Any], Any] = RotoEnv) -> int:
-    """Run trials until the study has ``settings.trials``; the number of trials this worker finished."""
+def run_worker(settings: SweepSettings, env_factory: Callable[[Any], Any] = RotoEnv, reclaim: bool = False) -> int:
+    """Run trials until the study has ``settings.trials`` and none is running; the number of
+    trials this worker finished. ``reclaim``: first fail and retry every running trial
+    (``--reclaim-now``)."""
     space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)  # checked first
     study, storage = open_study(settings)
-    finished = 0
+    if reclaim:
+        reclaim_now(study, storage)
+    finished, told = 0, set()
     while True:
         fail_stale_trials(study, storage, grace=4 * settings.heartbeat)
         if len(study.get_trials(deepcopy=False, states=ACTIVE)) >= settings.trials:
+            if wait_for_running(study, settings.heartbeat, told):
+                continue
             return finished
         trial = study.ask()
         if claimed_before(study, trial.number) >= settings.trials:

@@ -17,7 +17,8 @@ import shutil
 import socket
 import subprocess
 import tempfile
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 from typing import NamedTuple
 
 SUPERUSER = "roto"
@@ -54,9 +55,25 @@ def _version(folder: str) -> tuple[int, ...]:
     return tuple(int(part) for part in re.findall(r"\d+", pathlib.Path(folder).parent.name))
 
 
+class Server(NamedTuple):
+    """A running throwaway server: its URL, and a way to restart it (a fault to survive)."""
+
+    url: str
+    restart: Callable[[float], None]
+    """``restart(down_s)``: stop the server (connections dropped), wait ``down_s`` s, start it again."""
+
+
 @contextlib.contextmanager
 def postgres_server(binaries: Binaries | None = None) -> Iterator[str]:
-    """Run a fresh server on 127.0.0.1 and yield a SQLAlchemy URL of an empty database on it.
+    """Run a fresh server on 127.0.0.1 and yield a SQLAlchemy URL of an empty database on it
+    (``running_server``'s URL)."""
+    with running_server(binaries) as server:
+        yield server.url
+
+
+@contextlib.contextmanager
+def running_server(binaries: Binaries | None = None) -> Iterator[Server]:
+    """Run a fresh server on 127.0.0.1 with an empty database; yield its URL and its restart.
 
     The server is stopped and its files deleted on exit, also when the body raised. Raises
     RuntimeError when the binaries are missing or the server does not start.
@@ -69,6 +86,12 @@ def postgres_server(binaries: Binaries | None = None) -> Iterator[str]:
     user = _server_user()
     root = _make_root(user)
     data, log = root / "data", root / "server.log"
+
+    def restart(down_s: float) -> None:
+        _run([binaries.pg_ctl, "stop", "-D", data, "-m", "fast", "-w"], user, root)
+        time.sleep(down_s)
+        _start(binaries, data, log, user, root)
+
     try:
         _run([binaries.initdb, "-D", data, "-U", SUPERUSER, "--auth=trust", "--no-locale", "-E", "UTF8"], user, root)
         port = free_port()
@@ -76,7 +99,7 @@ def postgres_server(binaries: Binaries | None = None) -> Iterator[str]:
         try:
             _start(binaries, data, log, user, root)
             _create_database(port, log)
-            yield f"postgresql+psycopg2://{SUPERUSER}@127.0.0.1:{port}/{DATABASE}"
+            yield Server(f"postgresql+psycopg2://{SUPERUSER}@127.0.0.1:{port}/{DATABASE}", restart)
         finally:
             # immediate: the data is thrown away, so skip the shutdown checkpoint; -w returns once
             # the server has exited. It fails harmlessly when the server never started.
