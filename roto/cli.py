@@ -182,6 +182,7 @@ def _cmd_eval(args: argparse.Namespace) -> int:
     import pathlib
 
     from roto.eval.evaluate import evaluate
+    from roto.result_files import write_text_atomic
     from roto.rl.runner import load_policy
 
     out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
@@ -190,7 +191,7 @@ def _cmd_eval(args: argparse.Namespace) -> int:
     model, settings, _ = load_policy(args.checkpoint)
     result = evaluate(model, settings, episodes=args.episodes, seed=args.seed)
     result = {"checkpoint": str(args.checkpoint), "task": settings.env.task, "robot": settings.env.robot, **result}
-    out.write_text(json.dumps(result, indent=1))
+    write_text_atomic(out, json.dumps(result, indent=1))
     print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))
     print(f"wrote {out}", file=sys.stderr)
     return 0

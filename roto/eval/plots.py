@@ -8,6 +8,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from roto.result_files import replacing
 from roto.rl.evaluation import read_evaluations
 
 
@@ -56,7 +57,8 @@ def plot_learning_curve(run_dir: str | pathlib.Path, out: str | pathlib.Path | N
     fig.suptitle(f"{run_dir.name}: {len(records[-1]['per_episode']['return'])} episodes per evaluation")
     fig.tight_layout()
     path = pathlib.Path(out) if out is not None else run_dir / "learning_curve.png"
-    fig.savefig(path, dpi=100)
+    with replacing(path) as temporary:
+        fig.savefig(temporary, dpi=100, format=path.suffix.lstrip(".") or "png")
     plt.close(fig)
     return path
 
@@ -93,7 +95,8 @@ def plot_variants(
     fig.tight_layout()
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
+    with replacing(path) as temporary:
+        fig.savefig(temporary, dpi=100, format=path.suffix.lstrip(".") or "png")
     plt.close(fig)
     return path
 

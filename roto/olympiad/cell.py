@@ -21,6 +21,7 @@ from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
 from roto.eval.evaluate import evaluate
 from roto.olympiad.plan import Cell, Plan
+from roto.result_files import write_text_atomic
 from roto.rl.checkpoints import load_checkpoint
 from roto.rl.config import load_agent_config
 from roto.rl.evaluation import read_evaluations
@@ -82,5 +83,5 @@ def run_cell(
         "best": evaluate(best, trainer.settings, plan.eval_episodes, env_factory=env_factory),
     }
     results.mkdir(parents=True, exist_ok=True)
-    summary_path(results, cell).write_text(json.dumps(summary, indent=1))
+    write_text_atomic(summary_path(results, cell), json.dumps(summary, indent=1))
     return summary

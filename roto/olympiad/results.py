@@ -11,7 +11,6 @@ obs mode × variant are columns, with the scripted Bounce reference of each hand
 from __future__ import annotations
 
 import csv
-import json
 import pathlib
 from collections.abc import Iterable
 
@@ -19,6 +18,7 @@ import numpy as np
 
 from roto.eval.plots import plot_variants
 from roto.olympiad.stats import iqm, probability_of_improvement, stratified_bootstrap_ci
+from roto.result_files import read_json, replacing, write_text_atomic
 
 METRIC = {"bounce": "bounces", "baoding": "rotations"}
 SCRIPTED_BOUNCE = {"shadow": 27.9, "shadow_lite": 9.5, "allegro": 11.8, "orca": 12.0}
@@ -44,7 +44,7 @@ def read_summaries(folder: str | pathlib.Path) -> list[dict]:
     paths = sorted(pathlib.Path(folder).glob("*-seed*.json"))
     if not paths:
         raise FileNotFoundError(f"no cell summaries (<task>-<robot>-<obs>-<variant>-seed<k>.json) in {str(folder)!r}")
-    return [json.loads(path.read_text()) for path in paths]
+    return [read_json(path, "cell summary") for path in paths]
 
 
 def scores_by_cell(summaries: Iterable[dict], policy: str = "final") -> dict[Key, np.ndarray]:
@@ -100,7 +100,7 @@ def _format(stats: dict | None) -> str:
 
 def write_csv(scores: dict[Key, np.ndarray], path: pathlib.Path, policy: str) -> None:
     """One row per cell: its statistics and its seeds' scores."""
-    with path.open("w", newline="") as f:
+    with replacing(path) as temporary, temporary.open("w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(["policy", "task", "robot", "obs", "variant", "metric", "n", "mean", "std", "iqm",
                          "iqm_ci95_low", "iqm_ci95_high", "scores"])  # fmt: skip
@@ -142,6 +142,6 @@ def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str
     if pairs:
         md += ["## Probability of improvement (final policies)", ""]
         md += [f"- {t} / {r} / {o}: P({x} > {y}) = {p:.2f}" for t, r, o, x, y, p in pairs]
-    (out / "results.md").write_text("\n".join(md) + "\n")
+    write_text_atomic(out / "results.md", "\n".join(md) + "\n")
     plots = plot_curves(summaries, out, label)
     return {"markdown": str(out / "results.md"), "plots": [str(p) for p in plots], "cells": len(summaries)}

@@ -16,6 +16,7 @@ from typing import Any
 import torch
 
 from roto.eval.episodes import first_episodes
+from roto.result_files import write_text_atomic
 from roto.rl.networks import ActorCritic
 from roto.rl.torch_threads import single_torch_thread
 
@@ -72,9 +73,7 @@ class PolicyEvaluator:
         line; written atomically."""
         if self.path.is_file():
             kept = [json.dumps(r) for r in read_evaluation_records(self.path) if r["update"] <= update]
-            temporary = self.path.with_suffix(".jsonl.tmp")
-            temporary.write_text("".join(line + "\n" for line in kept))
-            temporary.replace(self.path)
+            write_text_atomic(self.path, "".join(line + "\n" for line in kept))
 
 
 def read_evaluation_records(path: pathlib.Path) -> list[dict[str, Any]]:

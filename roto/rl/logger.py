@@ -6,6 +6,8 @@ import csv
 import pathlib
 from typing import Any
 
+from roto.result_files import replacing
+
 CSV_NAME = "scalars.csv"
 
 
@@ -73,7 +75,5 @@ def drop_rows_after(path: pathlib.Path, update: int) -> None:
     kept = [row for row in body if len(row) == len(header) and row[1].isdigit() and int(row[1]) <= update]
     if len(kept) == len(body):
         return
-    temporary = path.with_suffix(".csv.tmp")
-    with temporary.open("w", newline="") as f:
+    with replacing(path) as temporary, temporary.open("w", newline="") as f:
         csv.writer(f).writerows([header, *kept])
-    temporary.replace(path)

@@ -10,6 +10,7 @@ from typing import Any
 import yaml
 
 from roto.envs.config import EnvConfig
+from roto.result_files import write_text_atomic
 from roto.rl.config import AgentConfig, from_dict, to_dict
 from roto.yaml_files import read_yaml
 
@@ -61,7 +62,7 @@ def run_config(settings: TrainSettings, agent: AgentConfig) -> dict[str, Any]:
 
 def write_run_config(run_dir: pathlib.Path, settings: TrainSettings, agent: AgentConfig) -> None:
     """The resolved config of a run (what ``--resume`` reads back)."""
-    (run_dir / CONFIG_NAME).write_text(yaml.safe_dump(run_config(settings, agent), sort_keys=False))
+    write_text_atomic(run_dir / CONFIG_NAME, yaml.safe_dump(run_config(settings, agent), sort_keys=False))
 
 
 def read_run_config(run_dir: pathlib.Path) -> tuple[TrainSettings, AgentConfig]:

@@ -8,6 +8,7 @@ import optuna
 import yaml
 from optuna.trial import TrialState
 
+from roto.result_files import write_text_atomic
 from roto.rl.config import load_agent_config, to_dict
 from roto.rl.overrides import split_overrides
 from roto.sweep.space import as_overrides
@@ -49,7 +50,7 @@ def export_best(
     ]
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(header) + "\n" + yaml.safe_dump(to_dict(agent), sort_keys=False))
+    write_text_atomic(path, "\n".join(header) + "\n" + yaml.safe_dump(to_dict(agent), sort_keys=False))
     return {"study": name, "trial": best.number, "value": best.value, "params": best.params, "out": str(path)}
 
 
