@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import pathlib
+import shutil
 import time
 from collections.abc import Callable
 from typing import Any
@@ -61,6 +62,16 @@ class EpisodeStats:
         return {f"train/episode_{tag}": mean for tag, mean in zip(tags, means, strict=True)}
 
 
+def first_missing(path: pathlib.Path) -> pathlib.Path | None:
+    """The outermost of ``path`` and its parents that does not exist yet (None: ``path`` exists)."""
+    missing = None
+    for folder in (path, *path.parents):
+        if folder.exists():
+            break
+        missing = folder
+    return missing
+
+
 class Trainer:
     """PPO on B training envs, evaluated every ``run.eval_every`` updates on separate envs.
 
@@ -89,8 +100,24 @@ class Trainer:
         self.settings, self.agent = settings, agent
         self.run_dir = pathlib.Path(run_dir)
         extra = extra_groups(agent, settings.env.obs_mode)  # checks the groups before anything is built
+        created = first_missing(self.run_dir)
         (self.run_dir / CHECKPOINT_DIR).mkdir(parents=True, exist_ok=True)
         self._lock = hold_run_lock(self.run_dir)  # held from here until train() returns
+        try:
+            self._build(env_factory, extra)
+        except BaseException:  # a refused env (too many envs, a bad file): leave no half-made run behind
+            if self._lock is not None:
+                self._lock.close()
+            if created is not None:
+                shutil.rmtree(created, ignore_errors=True)
+            raise
+        self.tensorboard = tensorboard
+        self.wandb_project = wandb_project
+        write_run_config(self.run_dir, settings, agent)
+
+    def _build(self, env_factory: Callable[[EnvConfig], Any], extra: tuple[str, ...]) -> None:
+        """The envs, the evaluator, the model and the learner; the counters at zero."""
+        settings, agent = self.settings, self.agent
         self.env = env_factory(settings.env_config(extra_groups=extra))
         self.device = self.env.device  # the policy learns where the envs simulate
         num_eval = agent.run.num_eval_envs_gpu if self.device.type == "cuda" else agent.run.num_eval_envs
@@ -111,9 +138,6 @@ class Trainer:
         self.train_seconds = 0.0  # rollouts + updates so far, summed over resumes (not evaluation or I/O)
         self.last_eval: dict[str, float] = {}
         self.obs: dict[str, torch.Tensor] | None = None
-        self.tensorboard = tensorboard
-        self.wandb_project = wandb_project
-        write_run_config(self.run_dir, settings, agent)
 
     @property
     def steps_per_update(self) -> int:

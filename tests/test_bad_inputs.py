@@ -1,0 +1,94 @@
+"""Bad input as a new user types it: every case is one line on stderr naming the value, file or URL
+(password hidden), exit code 2 (bad input) or 1 (runtime failure), no traceback, nothing written.
+
+Cases that need a trained run or a database live beside their features (tests/test_cli_training.py,
+tests/sweep/); this table is the rest, end to end through ``roto``'s entry point.
+"""
+
+import os
+
+import pytest
+
+from roto.cli import main
+
+MALFORMED = "ppo: {lr: 1e-3\nnetwork: [\n"
+
+
+def write(path, text):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return str(path)
+
+
+CASES = {
+    "malformed agent config": (
+        lambda d: ["train", "--steps", "16", "--agent_cfg", write(d / "bad.yaml", MALFORMED)],
+        2,
+        "is not valid YAML at line",
+    ),
+    "malformed search space": (
+        lambda d: ["sweep", "--study", "s", "--root", str(d / "sweeps"), "--space", write(d / "space.yaml", MALFORMED)],
+        2,
+        "is not valid YAML at line",
+    ),
+    "malformed Olympiad plan": (
+        lambda d: ["olympiad", write(d / "plan.yaml", MALFORMED), "--root", str(d / "o")],
+        2,
+        "is not valid YAML at line",
+    ),
+    "a billion envs": (lambda d: ["train", "--steps", "16", "--num_envs", "1000000000"], 2, "1000000000"),
+    "zero torch threads": (lambda d: ["train", "--steps", "16", "--torch_threads", "0"], 2, "--torch_threads"),
+    "negative C threads": (lambda d: ["train", "--steps", "16", "--threads", "-1"], 2, "-1"),
+    "video at a directory": (
+        lambda d: ["play", "--checkpoint", "x.pt", "--video", str(d)],
+        2,
+        "is a directory",
+    ),
+    "video under a file": (
+        lambda d: ["play", "--checkpoint", "x.pt", "--video", write(d / "file", "") + "/v.mp4"],
+        2,
+        "is not a directory",
+    ),
+    "unknown storage scheme": (
+        lambda d: ["sweep", "show", "--study", "s", "--storage", "nosuchdb://u:secret@host/db"],
+        2,
+        "nosuchdb://u:***@host/db",
+    ),
+    "malformed storage URL": (lambda d: ["sweep", "show", "--study", "s", "--storage", "postgresql://"], 2, "storage"),
+    "database port closed": (
+        lambda d: ["sweep", "show", "--study", "s", "--storage", "postgresql+psycopg2://u:secret@127.0.0.1:1/db"],
+        2,
+        "postgresql+psycopg2://u:***@127.0.0.1:1/db",
+    ),
+    "study name climbing out of the root": (
+        lambda d: ["sweep", "--study", "..", "--root", str(d / "sweeps")],
+        2,
+        "plain name",
+    ),
+    "two workers, bad space": (
+        lambda d: ["sweep", "--study", "s", "--root", str(d / "sweeps"), "--workers", "2", "--space", "nosuch"],
+        2,
+        "nosuch",
+    ),
+    "zero workers": (lambda d: ["olympiad", "cpu", "--root", str(d / "o"), "--workers", "0"], 2, "--workers"),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_bad_input_is_one_line_and_writes_nothing(case, tmp_path, monkeypatch, capsys):
+    if case.startswith("database") or case.endswith("storage URL"):
+        pytest.importorskip("psycopg2")
+    build, code, needle = CASES[case]
+    inputs = tmp_path / "inputs"
+    inputs.mkdir()
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    args = build(inputs)
+    before = sorted(os.listdir(inputs))
+    assert main(args) == code
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("roto "), err
+    assert needle in lines[0] and "secret" not in err
+    assert not os.listdir(work) and sorted(os.listdir(inputs)) == before  # nothing created or removed
