@@ -73,3 +73,30 @@ def test_a_worker_killed_by_a_signal_fails_the_command_and_is_named(capsys):
     assert worst_exit([2, -15, 0], [1, 2, 3]) == 2
     err = capsys.readouterr().err
     assert "worker 1 of 3 (pid 1) exited with 2" in err and "worker 2 of 3 (pid 2) was killed by SIGTERM" in err
+
+
+def test_a_wrong_database_password_is_one_line_without_the_password(postgres_binaries, capsys):
+    import pathlib
+    import re
+
+    import psycopg2
+
+    from roto.cli import main
+    from tests.sweep.postgres_server import running_server
+
+    with running_server(postgres_binaries) as server:
+        port = int(re.search(r":(\d+)/", server.url).group(1))
+        connection = psycopg2.connect(host="127.0.0.1", port=port, user="roto", dbname="postgres")
+        connection.autocommit = True
+        with connection.cursor() as cursor:  # password logins from here on
+            cursor.execute("ALTER USER roto PASSWORD 'right'")
+            cursor.execute("SHOW hba_file")
+            hba = pathlib.Path(cursor.fetchone()[0])
+            hba.write_text(hba.read_text().replace(" trust", " scram-sha-256"))
+            cursor.execute("SELECT pg_reload_conf()")
+        connection.close()
+        url = f"postgresql://roto:wrongpass@127.0.0.1:{port}/roto_test"
+        assert main(["sweep", "show", "--study", "s", "--storage", url]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "password authentication failed" in err
+    assert "wrongpass" not in err and f"roto:***@127.0.0.1:{port}" in err
