@@ -232,3 +232,18 @@ def test_play_to_a_path_that_cannot_be_a_video_is_one_line(trained_run, tmp_path
     assert err.startswith("roto play: error:") and len(err.strip().splitlines()) == 1
     with pytest.raises(ValueError):  # --debug shows the traceback instead
         main(["--debug", *args, "--video_length", "2"])
+
+
+def test_a_second_resume_of_a_run_in_use_is_refused_naming_the_process(trained_run, capsys):
+    import os
+
+    holder = Trainer.resume(trained_run, tensorboard=False)  # holds the run's lock until it trains or closes
+    try:
+        config = (trained_run / "config.yaml").read_bytes()
+        assert main(["train", "--resume", str(trained_run), "--no_progress"]) == 2
+        assert f"is in use by process {os.getpid()}" in capsys.readouterr().err
+        assert (trained_run / "config.yaml").read_bytes() == config
+    finally:
+        holder._lock.close()
+        holder.env.close()
+        holder.evaluator.env.close()
