@@ -210,9 +210,11 @@ def test_a_resume_after_a_crash_logs_each_update_once(tmp_path, capsys):
     import shutil
 
     run_dir = tmp_path / "run"
-    assert main(["train", "--num_envs", "4", "--steps", "48", "--run_dir", str(run_dir), "--no_progress", *TINY]) == 0
-    ckpts = run_dir / "checkpoints"
-    shutil.copy(ckpts / "agent_2.pt", ckpts / "latest.pt")  # as if it crashed before update 3's checkpoint
+    assert main(["train", "--num_envs", "4", "--steps", "32", "--run_dir", str(run_dir), "--no_progress", *TINY]) == 0
+    latest = run_dir / "checkpoints" / "latest.pt"
+    shutil.copy(latest, tmp_path / "latest_at_2.pt")
+    assert main(["train", "--resume", str(run_dir), "--steps", "48", "--no_progress"]) == 0
+    shutil.copy(tmp_path / "latest_at_2.pt", latest)  # as if it crashed before update 3's checkpoint
     assert main(["train", "--resume", str(run_dir), "--steps", "64", "--no_progress"]) == 0
     with (run_dir / "scalars.csv").open(newline="") as f:
         rows = list(csv.reader(f))[1:]

@@ -84,7 +84,9 @@ class RunConfig:
     eval_every: int = 25
     """Evaluate the current weights every this many updates (and after the last one)."""
     checkpoint_every: int = 50
-    """Write ``latest.pt`` (and keep ``agent_<update>.pt``) every this many updates."""
+    """Write ``latest.pt`` (and a numbered copy ``agent_<update>.pt``) every this many updates."""
+    keep_checkpoints: int = 2
+    """Numbered copies kept: the newest this many (0: none; ``latest.pt`` and ``best.pt`` always stay)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -107,6 +109,8 @@ class AgentConfig:
         for name, value in positive.items():
             if value < 1:
                 raise ValueError(f"{name} must be >= 1, got {value}")
+        if self.run.keep_checkpoints < 0:
+            raise ValueError(f"run.keep_checkpoints must be >= 0, got {self.run.keep_checkpoints}")
         if not (0.0 < p.gamma <= 1.0 and 0.0 <= p.lam <= 1.0):
             raise ValueError(f"ppo.gamma must be in (0, 1] and ppo.lam in [0, 1], got {p.gamma}, {p.lam}")
         if p.lr <= 0.0:

@@ -30,6 +30,9 @@ from roto.rl.torch_threads import single_torch_thread
 from roto.rl.wandb_run import logged_wandb_project, open_wandb_run, require_wandb
 
 CHECKPOINT_DIR = "checkpoints"
+POLICY_KEYS = ("model", "train", "agent", "obs_sizes", "num_actions", "update", "env_steps", "best_eval_return",
+               "last_eval")  # fmt: skip
+"""What a policy-only checkpoint holds: enough for ``load_policy``, ``roto eval`` and ``roto play``."""
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded with seed + this, so they never replay the training envs' resets."""
 
@@ -60,6 +63,12 @@ class EpisodeStats:
             return {}
         tags = [{"r": "return", "l": "length"}.get(n, n) for n in self.names]
         return {f"train/episode_{tag}": mean for tag, mean in zip(tags, means, strict=True)}
+
+
+def numbered_checkpoints(run_dir: pathlib.Path) -> list[pathlib.Path]:
+    """The run's ``agent_<update>.pt`` copies, oldest first."""
+    paths = (run_dir / CHECKPOINT_DIR).glob("agent_*.pt")
+    return sorted((p for p in paths if p.stem[6:].isdigit()), key=lambda p: int(p.stem[6:]))
 
 
 def first_missing(path: pathlib.Path) -> pathlib.Path | None:
@@ -233,15 +242,19 @@ class Trainer:
         self.last_eval = {f"eval/{key}": value for key, value in summary.items()}
         if record["return_mean"] > self.best_eval_return:
             self.best_eval_return = record["return_mean"]
-            self.save(self.run_dir / CHECKPOINT_DIR / "best.pt")
+            self.save(self.run_dir / CHECKPOINT_DIR / "best.pt", policy_only=True)
         return {**self.last_eval, "perf/eval_s": record["eval_s"]}
 
     def _checkpoint(self) -> None:
         every = self.agent.run.checkpoint_every
         if self.update % every == 0 or self.update == self.total_updates:
             self.save(self.run_dir / CHECKPOINT_DIR / "latest.pt")
+        keep = self.agent.run.keep_checkpoints
         if self.update % every == 0:
-            self.save(self.run_dir / CHECKPOINT_DIR / f"agent_{self.update}.pt")
+            if keep > 0:
+                self.save(self.run_dir / CHECKPOINT_DIR / f"agent_{self.update}.pt", policy_only=True)
+            for old in numbered_checkpoints(self.run_dir)[: -keep or None]:  # keep 0: every one goes
+                old.unlink()
 
     def _postfix(self, scalars: dict[str, float]) -> dict[str, str]:
         postfix = {"steps/s": f"{scalars['perf/steps_per_s']:.0f}"}
@@ -268,11 +281,20 @@ class Trainer:
             "last_eval": self.last_eval,
             "train": self.settings.to_dict(),
             "agent": to_dict(self.agent),
+            "obs_sizes": stacked_sizes(self.env),
+            "num_actions": self.env.num_actions,
         }
 
-    def save(self, path: pathlib.Path) -> None:
-        """Write a checkpoint atomically."""
-        save_checkpoint(self.state_dict(), path)
+    def policy_state(self) -> dict[str, Any]:
+        """The policy and what loading it needs (``POLICY_KEYS``): no optimiser or env state, a
+        third of ``state_dict``'s size."""
+        state = self.state_dict()
+        return {key: state[key] for key in POLICY_KEYS}
+
+    def save(self, path: pathlib.Path, policy_only: bool = False) -> None:
+        """Write a checkpoint atomically: everything to resume from, or with ``policy_only`` the
+        policy alone (``best.pt`` and the numbered copies)."""
+        save_checkpoint(self.policy_state() if policy_only else self.state_dict(), path)
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore a checkpoint written by ``save``; evaluations recorded after it are dropped."""
@@ -306,6 +328,11 @@ class Trainer:
         if not checkpoint.is_file():
             raise FileNotFoundError(f"no checkpoint to resume from: {str(checkpoint)!r} does not exist")
         state = load_checkpoint(checkpoint)  # read before anything is built or written
+        if "ppo" not in state:
+            raise ValueError(
+                f"{str(checkpoint)!r} holds a policy only (as best.pt and the numbered copies do), not the "
+                "optimiser and env state a resume needs"
+            )
         if total_steps is not None and total_steps < int(state["env_steps"]):
             raise ValueError(
                 f"step budget {total_steps} is below the {int(state['env_steps'])} env steps {str(run_dir)!r} has "
@@ -327,9 +354,13 @@ def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSetti
     settings = TrainSettings.from_dict(state["train"])
     agent = from_dict(AgentConfig, state["agent"]).validate()
     obs_mode = settings.env.obs_mode
-    env = RotoEnv(settings.cpu_env_config(num_envs=1, extra_groups=extra_groups(agent, obs_mode)))
-    model = build_model(stacked_sizes(env), env.num_actions, agent, obs_mode)
-    env.close()
+    if "obs_sizes" in state:
+        sizes, num_actions = {k: int(v) for k, v in state["obs_sizes"].items()}, int(state["num_actions"])
+    else:  # written before checkpoints carried their sizes: an env tells them
+        env = RotoEnv(settings.cpu_env_config(num_envs=1, extra_groups=extra_groups(agent, obs_mode)))
+        sizes, num_actions = stacked_sizes(env), env.num_actions
+        env.close()
+    model = build_model(sizes, num_actions, agent, obs_mode)
     model.load_state_dict(state["model"])
     model.eval()
     return model, settings, agent

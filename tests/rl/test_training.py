@@ -93,11 +93,19 @@ def test_resume_is_bit_identical_with_auxiliary_losses_and_a_privileged_critic(t
 
 
 def test_resume_forgets_evaluations_recorded_after_its_checkpoint(tmp_path):
+    import shutil
+
     from roto.rl.evaluation import read_evaluations
 
-    tiny_trainer(tmp_path, "run", 3, extra=["run.eval_every=1", "run.checkpoint_every=2"]).train(progress=False)
-    (tmp_path / "run" / "checkpoints" / "latest.pt").unlink()
-    (tmp_path / "run" / "checkpoints" / "agent_2.pt").rename(tmp_path / "run" / "checkpoints" / "latest.pt")
+    latest, aside = tmp_path / "run" / "checkpoints" / "latest.pt", tmp_path / "latest_at_2.pt"
+
+    def keep_update_2(trainer, scalars):
+        if trainer.update == 2:
+            shutil.copy(latest, aside)
+
+    trainer = tiny_trainer(tmp_path, "run", 3, extra=["run.eval_every=1", "run.checkpoint_every=2"])
+    trainer.train(progress=False, on_update=keep_update_2)
+    aside.replace(latest)
     resumed = Trainer.resume(tmp_path / "run", tensorboard=False)  # a crash after update 3's evaluation
     assert resumed.update == 2
     assert [r["update"] for r in read_evaluations(tmp_path / "run")] == [1, 2]
@@ -182,3 +190,45 @@ def test_one_run_directory_serves_one_trainer_at_a_time(tmp_path):
     resumed = Trainer.resume(tmp_path / "run", total_steps=32, tensorboard=False)
     resumed.train(progress=False)
     assert resumed.update == 2
+
+
+@pytest.mark.parametrize(("keep", "numbered"), [(2, ["agent_4.pt", "agent_5.pt"]), (0, [])])
+def test_only_the_newest_numbered_checkpoints_are_kept(tmp_path, keep, numbered):
+    extra = ["run.checkpoint_every=1", "run.eval_every=1", f"run.keep_checkpoints={keep}"]
+    tiny_trainer(tmp_path, "run", 5, extra=extra).train(progress=False)
+    names = sorted(p.name for p in (tmp_path / "run" / "checkpoints").iterdir())
+    assert names == sorted(["best.pt", "latest.pt", *numbered])
+
+
+def test_a_negative_checkpoint_count_is_refused():
+    with pytest.raises(ValueError, match=r"run\.keep_checkpoints must be >= 0, got -1"):
+        load_agent_config("bounce", overrides=["run.keep_checkpoints=-1"])
+
+
+def test_best_and_numbered_checkpoints_hold_the_policy_and_load_without_an_env(tmp_path, monkeypatch):
+    import roto.rl.runner as runner
+
+    trainer = tiny_trainer(tmp_path, "run", 2, extra=["run.eval_every=1", "run.checkpoint_every=1"])
+    trainer.train(progress=False)
+    folder = tmp_path / "run" / "checkpoints"
+    full = torch.load(folder / "latest.pt", weights_only=True)
+    for name in ("best.pt", "agent_2.pt"):
+        policy = torch.load(folder / name, weights_only=True)
+        assert set(policy) == set(runner.POLICY_KEYS) and "ppo" in full and "env" in full
+        assert (folder / name).stat().st_size < 0.5 * (folder / "latest.pt").stat().st_size
+
+    def no_env(*args, **kwargs):
+        raise AssertionError("loading a policy built an env")
+
+    monkeypatch.setattr(runner, "RotoEnv", no_env)
+    model, _, _ = runner.load_policy(folder / "agent_2.pt")
+    trained = trainer.model.state_dict()
+    assert all(torch.equal(value, trained[key]) for key, value in model.state_dict().items())
+
+
+def test_resuming_from_a_policy_only_checkpoint_says_so(tmp_path):
+    tiny_trainer(tmp_path, "run", 1, extra=["run.eval_every=1"]).train(progress=False)
+    folder = tmp_path / "run" / "checkpoints"
+    (folder / "best.pt").replace(folder / "latest.pt")
+    with pytest.raises(ValueError, match="holds a policy only"):
+        Trainer.resume(tmp_path / "run", tensorboard=False)
