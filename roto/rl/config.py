@@ -1,7 +1,8 @@
 """Agent configuration: frozen dataclasses read from plain YAML with strict keys.
 
 A config file mirrors ``AgentConfig``: sections ``network``, ``ppo``, ``ssl`` and ``run``. An unknown
-key is an error naming its dotted path and the valid keys; a missing key keeps its default.
+key is an error naming its dotted path and the valid keys; a missing key keeps its default. A file
+may start from another with ``extends: NAME`` and list only what it changes.
 ``key=value`` overrides (e.g. ``ppo.lr=1e-4``, ``ssl.forward_dynamics.weight=0.01``) are applied on
 top, with the value parsed as YAML.
 """
@@ -236,14 +237,55 @@ def resolve_config_path(task: str, path: str | pathlib.Path | None) -> pathlib.P
     )
 
 
+EXTENDS = "extends"
+"""Top-level key of an agent config naming the config it changes (a packaged name or a file)."""
+
+
+def merge(base: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
+    """``base`` with ``changes`` on top: sections merge key by key, any other value replaces."""
+    merged = dict(base)
+    for key, value in changes.items():
+        both_sections = isinstance(value, dict) and isinstance(merged.get(key), dict)
+        merged[key] = merge(merged[key], value) if both_sections else value
+    return merged
+
+
+def read_agent_data(config_path: pathlib.Path, chain: tuple[pathlib.Path, ...] = ()) -> dict[str, Any]:
+    """The settings of the agent config at ``config_path``, its ``extends:`` chain resolved.
+
+    ``extends: NAME`` names a packaged config or a YAML file (relative to this file's folder); the
+    file then lists only what it changes. Raises ValueError for an empty file, a cycle, or a base
+    that does not exist (naming the extending file).
+    """
+    data = read_yaml(config_path, "agent config")
+    if data is None:
+        raise ValueError(f"agent config {str(config_path)!r} is empty; it would train on defaults it never names")
+    if not isinstance(data, dict) or EXTENDS not in data:
+        return data
+    data = dict(data)
+    base_name = str(data.pop(EXTENDS))
+    beside = config_path.parent / base_name
+    shipped = packaged_configs()
+    if beside.is_file():
+        base_path = beside
+    elif base_name in shipped:
+        base_path = shipped[base_name]
+    else:
+        raise ValueError(
+            f"agent config {str(config_path)!r} extends {base_name!r}, which is neither a file beside it nor a "
+            f"packaged config: {sorted(shipped)}"
+        )
+    if base_path.resolve() in chain or base_path.resolve() == config_path.resolve():
+        names = " -> ".join(str(p) for p in (*chain, config_path.resolve(), base_path.resolve()))
+        raise ValueError(f"agent configs extend each other in a circle: {names}")
+    return merge(read_agent_data(base_path, (*chain, config_path.resolve())), data)
+
+
 def load_agent_config(
     task: str, path: str | pathlib.Path | None = None, overrides: list[str] | None = None
 ) -> AgentConfig:
     """The task's default config, or ``path`` (a YAML file or packaged name), with ``overrides``; validated."""
-    config_path = resolve_config_path(task, path)
-    data = read_yaml(config_path, "agent config")
-    if data is None:
-        raise ValueError(f"agent config {str(config_path)!r} is empty; it would train on defaults it never names")
+    data = read_agent_data(resolve_config_path(task, path))
     data = apply_overrides(data, overrides or [])
     return from_dict(AgentConfig, data).validate()
 

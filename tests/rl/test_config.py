@@ -104,3 +104,46 @@ def test_max_log_std_bounds_the_policy_std():
         build_model(
             {"tactile": 4, "proprio": 8}, 3, load_agent_config("bounce", overrides=["network.max_log_std=-30"]), "blind"
         )
+
+
+def test_a_config_extends_another_and_lists_only_what_changes(tmp_path):
+    base = tmp_path / "base.yaml"
+    base.write_text("extends: bounce_privileged_critic\nppo: {epochs: 3, lr: 1.0e-4}\n")
+    child = tmp_path / "child.yaml"
+    child.write_text("extends: base.yaml\nppo: {lr: 2.0e-4}\nnetwork: {encoder: [64]}\n")
+    config = load_agent_config("bounce", child)
+    roto = load_agent_config("bounce")
+    assert config.ppo.lr == 2.0e-4 and config.ppo.epochs == 3  # the child's, then the base's
+    assert config.network.encoder == (64,) and config.network.critic == ("tactile", "proprio", "privileged")
+    assert config.ppo.minibatches == roto.ppo.minibatches and config.run == roto.run  # the packaged root's
+
+
+def test_every_packaged_diff_config_differs_from_its_base_only_where_it_says():
+    import yaml
+
+    from roto.rl.config import merge
+
+    for name, path in packaged_configs().items():
+        data = yaml.safe_load(path.read_text())
+        if "extends" not in data:
+            continue
+        task = "baoding" if name.startswith("baoding") else "bounce"
+        base = to_dict(load_agent_config(task, data.pop("extends")))
+        assert to_dict(load_agent_config(task, name)) == to_dict(from_dict(AgentConfig, merge(base, data)))
+        changed = {f"{s}.{k}" for s, section in data.items() for k in section}
+        assert changed, f"{name} extends its base without changing anything"
+
+
+@pytest.mark.parametrize(
+    ("files", "message"),
+    [
+        ({"a.yaml": "extends: a.yaml\n"}, "extend each other in a circle"),
+        ({"a.yaml": "extends: b.yaml\n", "b.yaml": "extends: a.yaml\n"}, "extend each other in a circle"),
+        ({"a.yaml": "extends: nosuch\n"}, "extends 'nosuch', which is neither a file beside it nor a packaged"),
+    ],
+)
+def test_a_bad_extends_is_a_clear_error(tmp_path, files, message):
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    with pytest.raises(ValueError, match=message):
+        load_agent_config("bounce", tmp_path / "a.yaml")
