@@ -10,6 +10,7 @@ from collections.abc import Sequence
 
 from roto.cli_errors import check_output_file, error_exit
 from roto.olympiad.command import add_olympiad_parsers
+from roto.rl.config_help import HelpConfigAction
 from roto.sweep.command import add_sweep_parser
 
 
@@ -251,6 +252,7 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
         help="torch CPU threads for the PPO update; rollouts always use one (default 1)",
     )
     p_train.add_argument("--no_progress", "--no-progress", dest="no_progress", action="store_true")
+    p_train.add_argument("--help-config", "--help_config", action=HelpConfigAction)
     p_train.add_argument(
         "--logger",
         choices=("tensorboard", "wandb"),

@@ -31,8 +31,11 @@ class NetworkConfig:
     encoder: tuple[int, ...] = (512, 256)
     """Hidden sizes of the encoder (Linear -> LayerNorm -> ELU each)."""
     policy_head: tuple[int, ...] = (128, 64)
+    """Hidden sizes of the policy head on the encoder's latent (ELU), then a linear layer to the action means."""
     value_head: tuple[int, ...] = (128, 64)
+    """Hidden sizes of the value head (ELU), then a linear layer to the value."""
     init_log_std: float = 0.0
+    """Initial log standard deviation of the Gaussian policy (a state-independent parameter per action)."""
     max_log_std: float = 2.0
     """Upper bound of the policy's log standard deviation (roto's clamp: 2, a std of 7.4 in action
     units of ±1). A lower bound keeps a small batch's sampled actions near the mean action
@@ -52,23 +55,41 @@ class PPOConfig:
     """PPO hyperparameters (docs/spec.md §7; defaults are roto's Bounce values)."""
 
     rollouts: int = 16
+    """Steps each env collects per update: an update learns from rollouts x num_envs transitions."""
     epochs: int = 17
+    """Passes over the collected transitions per update."""
     minibatches: int = 8
+    """Minibatches per epoch (each an Adam step on rollouts x num_envs / minibatches transitions)."""
     gamma: float = 0.99
+    """Discount factor."""
     lam: float = 0.951
+    """GAE lambda."""
     lr: float = 2.59e-4
+    """Adam learning rate (the starting rate when ``kl_adaptive``)."""
     ratio_clip: float = 0.285
+    """PPO's clip of the probability ratio, 1 ± this."""
     value_clip: float = 0.105
+    """Clip of the value prediction's change from the rollout's value, ± this (in normalised units)."""
     value_coef: float = 0.999
+    """Weight of the value loss in the total loss."""
     entropy_coef: float = 0.0161
+    """Weight of the entropy bonus (subtracted from the loss)."""
     max_grad_norm: float = 1.0
+    """Gradients are clipped to this global norm before each Adam step."""
     kl_adaptive: bool = False
+    """Adapt the learning rate after each epoch (from its mean KL) to keep the policy's change near ``kl_target``."""
     kl_target: float = 0.008
+    """KL between the old and new policy the adaptive rate aims at."""
     kl_factor: float = 1.5
+    """The adaptive rate is divided by this when the KL exceeds twice the target, multiplied when below half."""
     lr_min: float = 1e-6
+    """Lowest learning rate the adaptive rate may reach."""
     lr_max: float = 1e-2
+    """Highest learning rate the adaptive rate may reach."""
     value_normalization: bool = True
+    """Learn values in units of the returns' running standard deviation."""
     bootstrap_timeouts: bool = False
+    """At a time-out, bootstrap the return with the critic's value of the last state (roto: no)."""
     cuda_graph: bool = False
     """Replay each minibatch step from a CUDA graph (roto/rl/graphed_step.py): the same update with
     far fewer kernel launches. CUDA devices only, without auxiliary losses."""
