@@ -128,10 +128,8 @@ def _cmd_train(args: argparse.Namespace) -> int:
 
     import torch
 
-    from roto.envs.config import EnvConfig
-    from roto.rl.config import load_agent_config
-    from roto.rl.overrides import apply_env_overrides, split_overrides
-    from roto.rl.runner import Trainer, TrainSettings
+    from roto.rl.run_spec import DEFAULT_STEPS, build_run_spec
+    from roto.rl.runner import Trainer
     from roto.rl.settings import CONFIG_NAME
 
     if isinstance(args.torch_threads, bool) or args.torch_threads < 1:
@@ -144,32 +142,22 @@ def _cmd_train(args: argparse.Namespace) -> int:
                 f"--resume continues a run as it was configured; the overrides {args.overrides} would be ignored: "
                 "drop them, or start a new run with --run_dir"
             )
-        trainer = Trainer.resume(args.resume, total_steps=args.steps, wandb_project=wandb_project)
+        trainer = Trainer.open(args.resume, steps=args.steps, wandb_project=wandb_project)
     else:
-        env_changes, agent_overrides = split_overrides(args.overrides)
-        env = EnvConfig(  # validates task / robot / obs mode / backend before anything is written
-            task=args.task,
-            robot=args.robot,
-            obs_mode=args.obs,
-            num_envs=args.num_envs,
-            seed=args.seed,
-            backend=args.backend,
-            device=args.device,
-            threads=args.threads,
-            touch=args.touch,
-        )
-        env = apply_env_overrides(env, env_changes)
-        settings = TrainSettings(env=env, total_steps=args.steps if args.steps is not None else 1_000_000)
-        agent = load_agent_config(args.task, args.agent_cfg, agent_overrides)
+        # the env flags are shorthand for env.* overrides, which win over them; all checked before anything is written
+        flags = dict(num_envs=args.num_envs, seed=args.seed, backend=args.backend, device=args.device,
+                     threads=args.threads, touch=args.touch)  # fmt: skip
+        steps = args.steps if args.steps is not None else DEFAULT_STEPS
+        spec = build_run_spec(args.task, args.robot, args.obs, args.agent_cfg, args.overrides, steps, **flags)
         run_dir = args.run_dir or pathlib.Path("runs") / (
-            f"{args.task}_{args.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{args.seed}"
+            f"{args.task}_{args.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{spec.env.seed}"
         )
         if (pathlib.Path(run_dir) / CONFIG_NAME).exists():
             raise ValueError(
                 f"--run_dir {str(run_dir)!r} already holds a run; continue it with --resume {str(run_dir)!r}, "
                 "or choose another directory"
             )
-        trainer = Trainer(settings, agent, run_dir, wandb_project=wandb_project)
+        trainer = Trainer.open(run_dir, spec, wandb_project=wandb_project)
     print(f"run directory: {trainer.run_dir}", file=sys.stderr)
     last = trainer.train(progress=not args.no_progress)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
@@ -184,7 +172,7 @@ def _cmd_eval(args: argparse.Namespace) -> int:
 
     from roto.eval.evaluate import evaluate
     from roto.result_files import write_text_atomic
-    from roto.rl.runner import load_policy
+    from roto.rl.run_dir import load_policy
 
     out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
     if not out.parent.is_dir():  # before the evaluation, which would be lost
@@ -200,7 +188,7 @@ def _cmd_eval(args: argparse.Namespace) -> int:
 
 def _cmd_play(args: argparse.Namespace) -> int:
     from roto.eval.video import record_video
-    from roto.rl.runner import load_policy
+    from roto.rl.run_dir import load_policy
 
     check_output_file(args.video, "--video")
     model, settings, _ = load_policy(args.checkpoint)

@@ -8,7 +8,8 @@ import pytest
 import yaml
 
 from roto.cli import main
-from roto.rl.runner import Trainer, load_policy
+from roto.rl.run_dir import load_policy
+from roto.rl.runner import Trainer
 
 TINY = [
     "network.encoder=[16]",

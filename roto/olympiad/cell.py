@@ -11,6 +11,7 @@ cells trained on other machines or in other sittings combine.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 import pathlib
 import subprocess
@@ -23,10 +24,10 @@ from roto.eval.evaluate import evaluate
 from roto.olympiad.plan import Cell, Plan
 from roto.result_files import write_text_atomic
 from roto.rl.checkpoints import load_checkpoint
-from roto.rl.config import load_agent_config
 from roto.rl.evaluation import read_evaluations
-from roto.rl.runner import CHECKPOINT_DIR, Trainer
-from roto.rl.settings import TrainSettings
+from roto.rl.run_dir import CHECKPOINT_DIR
+from roto.rl.run_spec import RunSpec, build_run_spec
+from roto.rl.runner import Trainer
 
 
 def code_commit() -> str:
@@ -40,12 +41,13 @@ def summary_path(results: pathlib.Path, cell: Cell) -> pathlib.Path:
     return results / f"{cell.name}.json"
 
 
-def new_trainer(plan: Plan, cell: Cell, run_dir: pathlib.Path, env_factory: Callable[[EnvConfig], Any]) -> Trainer:
-    """The cell's trainer before any update: the plan's envs, the variant's agent for the task."""
-    env = EnvConfig(task=cell.task, robot=cell.robot, obs_mode=cell.obs, num_envs=plan.num_envs, seed=cell.seed,
-                    threads=plan.threads, backend=plan.backend, device=plan.device)  # fmt: skip
-    agent = load_agent_config(cell.task, *plan.variants[cell.variant].agent_for(cell.task))
-    return Trainer(TrainSettings(env=env, total_steps=plan.steps), agent, run_dir, env_factory=env_factory)
+def cell_spec(plan: Plan, cell: Cell) -> RunSpec:
+    """What a cell trains: the plan's envs and budget, the variant's agent and env overrides for the
+    task, the cell's seed (which wins over any ``env.seed`` override)."""
+    agent_cfg, overrides = plan.variants[cell.variant].agent_for(cell.task)
+    spec = build_run_spec(cell.task, cell.robot, cell.obs, agent_cfg, overrides, plan.steps, num_envs=plan.num_envs,
+                          threads=plan.threads, backend=plan.backend, device=plan.device)  # fmt: skip
+    return dataclasses.replace(spec, env=dataclasses.replace(spec.env, seed=cell.seed))
 
 
 def run_cell(
@@ -57,10 +59,7 @@ def run_cell(
     env_factory: Callable[[EnvConfig], Any] = RotoEnv,
 ) -> dict[str, Any]:
     """Train (or continue) the cell, evaluate it, write and return its summary."""
-    if (run_dir / CHECKPOINT_DIR / "latest.pt").is_file():
-        trainer = Trainer.resume(run_dir, env_factory=env_factory)
-    else:
-        trainer = new_trainer(plan, cell, run_dir, env_factory)
+    trainer = Trainer.open(run_dir, cell_spec(plan, cell), env_factory=env_factory)
     try:
         trainer.train(progress=False)
     finally:

@@ -7,9 +7,11 @@ A plan is a YAML file::
     num_envs: 128
     threads: 2
     variants:               # name -> per task: agent config (a file or packaged name; null or
-      ppo:                  #   left out: the task's default) and overrides
-        bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004]}
+      ppo:                  #   left out: the task's default) and overrides (agent keys, and env.*
+        bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004]}  # keys such as env.touch)
         baoding: {overrides: [ppo.epochs=4]}
+      force_touch:
+        bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004, env.touch=force]}
     grids:                  # the cells: the union of these products
       - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0, 1]}
 
@@ -27,8 +29,8 @@ from typing import Any
 
 from roto.envs.observations import OBS_MODES
 from roto.rl.build import resolve_groups
-from roto.rl.config import load_agent_config
 from roto.rl.overrides import split_overrides
+from roto.rl.run_spec import build_run_spec
 from roto.robots import ROBOTS
 from roto.sim.backend import BACKENDS
 from roto.tasks import TASKS
@@ -143,9 +145,7 @@ def _variant(name: str, spec: Any, where: str) -> Variant:
     for task, entry in spec.items():
         _check_keys(entry or {}, VARIANT_KEYS, f"{where}, task {task!r}")
         overrides = tuple((entry or {}).get("overrides") or ())
-        env_changes, _ = split_overrides(list(overrides))
-        if env_changes:
-            raise ValueError(f"{where}: env overrides {sorted(env_changes)} belong to the plan, not a variant")
+        split_overrides(list(overrides))  # env keys checked here; their values with the cells' envs
         per_task.append((task, (entry or {}).get("agent_cfg"), overrides))
     return Variant(name, tuple(per_task))
 
@@ -164,11 +164,12 @@ def _grid_cells(grid: Any, variants: dict[str, Variant], where: str) -> list[Cel
     for seed in grid["seeds"]:
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise ValueError(f"{where}: seeds must be integers >= 0, got {seed!r}")
-    for task, obs, name in itertools.product(grid["tasks"], grid["obs"], grid["variants"]):
-        try:  # the variant's config must load for this task and obs mode (groups included)
-            resolve_groups(load_agent_config(task, *variants[name].agent_for(task)), obs)
+    for task, robot, obs, name in itertools.product(grid["tasks"], grid["robots"], grid["obs"], grid["variants"]):
+        try:  # the variant's config and env overrides must hold for this pair and obs mode (groups included)
+            spec = build_run_spec(task, robot, obs, *variants[name].agent_for(task))
+            resolve_groups(spec.agent, obs)
         except (ValueError, FileNotFoundError) as error:
-            raise ValueError(f"{where}: variant {name!r} on {task}/{obs}: {error}") from None
+            raise ValueError(f"{where}: variant {name!r} on {task}/{robot}/{obs}: {error}") from None
     return [
         Cell(*values)
         for values in itertools.product(grid["tasks"], grid["robots"], grid["obs"], grid["variants"], grid["seeds"])

@@ -104,7 +104,7 @@ def help_config() -> str:
 
     lines = ["Agent config keys (a YAML file's sections, or section.key=value overrides), with their defaults:"]
     lines += block(config_keys(AgentConfig))
-    lines += ["", "Env keys (env.key=value overrides; task, robot, obs mode, backend, device and seed are flags):"]
+    lines += ["", "Env keys (env.key=value overrides; task, robot and obs mode are the run's own flags):"]
     lines += block(config_keys(EnvConfig, "env.", skip=FIXED_ENV_KEYS))
     return "\n".join(lines)
 

@@ -14,8 +14,9 @@ from roto.envs.config import EnvConfig
 from roto.rl.config import parse_override
 
 ENV_SECTION = "env"
-FIXED_ENV_KEYS = ("task", "robot", "obs_mode", "extra_groups", "backend", "device", "seed")
-"""Env fields no override sets: the command's own arguments (or the learner) decide them."""
+FIXED_ENV_KEYS = ("task", "robot", "obs_mode", "extra_groups")
+"""Env fields no override sets: what the run is (task, robot, obs mode) and what the learner reads
+besides the policy's groups."""
 
 
 def env_override_keys() -> list[str]:

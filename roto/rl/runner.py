@@ -20,19 +20,16 @@ from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import build_learner, build_model, extra_groups, stacked_sizes
 from roto.rl.checkpoints import load_checkpoint, save_checkpoint
-from roto.rl.config import AgentConfig, from_dict, to_dict
+from roto.rl.config import AgentConfig, to_dict
 from roto.rl.evaluation import PolicyEvaluator
 from roto.rl.logger import ScalarLogger
-from roto.rl.networks import ActorCritic
+from roto.rl.run_dir import CHECKPOINT_DIR, POLICY_KEYS, first_missing, numbered_checkpoints
 from roto.rl.run_lock import hold_run_lock
+from roto.rl.run_spec import RunSpec
 from roto.rl.settings import TrainSettings, read_run_config, run_config, write_run_config
 from roto.rl.torch_threads import single_torch_thread
 from roto.rl.wandb_run import logged_wandb_project, open_wandb_run, require_wandb
 
-CHECKPOINT_DIR = "checkpoints"
-POLICY_KEYS = ("model", "train", "agent", "obs_sizes", "num_actions", "update", "env_steps", "best_eval_return",
-               "last_eval")  # fmt: skip
-"""What a policy-only checkpoint holds: enough for ``load_policy``, ``roto eval`` and ``roto play``."""
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded with seed + this, so they never replay the training envs' resets."""
 
@@ -63,22 +60,6 @@ class EpisodeStats:
             return {}
         tags = [{"r": "return", "l": "length"}.get(n, n) for n in self.names]
         return {f"train/episode_{tag}": mean for tag, mean in zip(tags, means, strict=True)}
-
-
-def numbered_checkpoints(run_dir: pathlib.Path) -> list[pathlib.Path]:
-    """The run's ``agent_<update>.pt`` copies, oldest first."""
-    paths = (run_dir / CHECKPOINT_DIR).glob("agent_*.pt")
-    return sorted((p for p in paths if p.stem[6:].isdigit()), key=lambda p: int(p.stem[6:]))
-
-
-def first_missing(path: pathlib.Path) -> pathlib.Path | None:
-    """The outermost of ``path`` and its parents that does not exist yet (None: ``path`` exists)."""
-    missing = None
-    for folder in (path, *path.parents):
-        if folder.exists():
-            break
-        missing = folder
-    return missing
 
 
 class Trainer:
@@ -310,6 +291,43 @@ class Trainer:
         self.evaluator.drop_after(self.update)
 
     @classmethod
+    def open(
+        cls,
+        run_dir: str | pathlib.Path,
+        spec: RunSpec | None = None,
+        *,
+        steps: int | None = None,
+        tensorboard: bool = True,
+        env_factory: Callable[[EnvConfig], Any] = RotoEnv,
+        wandb_project: str | None = None,
+    ) -> Trainer:
+        """The run in ``run_dir``: continued from its latest checkpoint when it has one, else created
+        from ``spec``.
+
+        With a spec, a run that exists must train what the spec says (only its budget may grow,
+        to ``spec.steps``); without one, ``steps`` is a new budget for the run (None: unchanged).
+
+        Raises:
+            ValueError listing the differences when an existing run was configured otherwise;
+            FileNotFoundError (via ``resume``) when there is neither a checkpoint nor a spec.
+        """
+        run_dir = pathlib.Path(run_dir)
+        has_checkpoint = (run_dir / CHECKPOINT_DIR / "latest.pt").is_file()
+        if spec is None or has_checkpoint:
+            if spec is not None:
+                settings, agent = read_run_config(run_dir)
+                stored = RunSpec(env=settings.env, agent=agent, steps=settings.total_steps)
+                differ = spec.differences(stored)
+                if differ:
+                    raise ValueError(
+                        f"run {str(run_dir)!r} exists with other settings (given, stored): {differ}; continue it as "
+                        "it is, or start another run directory"
+                    )
+                steps = spec.steps
+            return cls.resume(run_dir, steps, tensorboard, env_factory, wandb_project)
+        return cls(spec.settings, spec.agent, run_dir, tensorboard, env_factory, wandb_project)
+
+    @classmethod
     def resume(
         cls,
         run_dir: str | pathlib.Path,
@@ -346,21 +364,3 @@ class Trainer:
         )
         trainer.load_state_dict(state if trainer.device.type == "cpu" else load_checkpoint(checkpoint, trainer.device))
         return trainer
-
-
-def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSettings, AgentConfig]:
-    """The policy stored in a checkpoint (on the CPU, in eval mode), with the run's settings."""
-    state = load_checkpoint(checkpoint)
-    settings = TrainSettings.from_dict(state["train"])
-    agent = from_dict(AgentConfig, state["agent"]).validate()
-    obs_mode = settings.env.obs_mode
-    if "obs_sizes" in state:
-        sizes, num_actions = {k: int(v) for k, v in state["obs_sizes"].items()}, int(state["num_actions"])
-    else:  # written before checkpoints carried their sizes: an env tells them
-        env = RotoEnv(settings.cpu_env_config(num_envs=1, extra_groups=extra_groups(agent, obs_mode)))
-        sizes, num_actions = stacked_sizes(env), env.num_actions
-        env.close()
-    model = build_model(sizes, num_actions, agent, obs_mode)
-    model.load_state_dict(state["model"])
-    model.eval()
-    return model, settings, agent

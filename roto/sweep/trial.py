@@ -10,6 +10,7 @@ reason stored on the trial.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import pathlib
 from collections.abc import Callable
@@ -20,11 +21,9 @@ import torch
 
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
-from roto.rl.config import load_agent_config
 from roto.rl.evaluation import read_evaluations
-from roto.rl.overrides import apply_env_overrides, split_overrides
-from roto.rl.runner import CHECKPOINT_DIR, Trainer
-from roto.rl.settings import TrainSettings
+from roto.rl.run_spec import RunSpec, build_run_spec
+from roto.rl.runner import Trainer
 from roto.sweep.space import SearchSpace, as_overrides
 from roto.sweep.storage import RETRY_OF_ATTR
 from roto.sweep.study import SweepSettings, trial_seed
@@ -62,14 +61,14 @@ class TrialMonitor:
             )
 
 
-def build_trainer(
-    settings: SweepSettings, params: dict[str, Any], run_dir: pathlib.Path, seed: int, env_factory: Callable
-) -> Trainer:
-    """A trainer for a new trial: the study's env and base config with the drawn parameters."""
-    env_changes, agent_overrides = split_overrides([*settings.overrides, *as_overrides(params)])
-    env = apply_env_overrides(settings.base_env(seed), env_changes)
-    agent = load_agent_config(settings.task, settings.agent_cfg, agent_overrides)
-    return Trainer(TrainSettings(env=env, total_steps=settings.steps), agent, run_dir, env_factory=env_factory)
+def trial_spec(settings: SweepSettings, params: dict[str, Any], seed: int) -> RunSpec:
+    """What a trial trains: the study's run with its fixed overrides, then the drawn parameters; the
+    trial's seed wins over any ``env.seed`` override."""
+    spec = build_run_spec(
+        settings.task, settings.robot, settings.obs, settings.agent_cfg, [*settings.overrides, *as_overrides(params)],
+        settings.steps, num_envs=settings.num_envs, threads=settings.threads,
+    )  # fmt: skip
+    return dataclasses.replace(spec, env=dataclasses.replace(spec.env, seed=seed))
 
 
 def run_trial(
@@ -91,13 +90,10 @@ def run_trial(
     trial.set_user_attr("seed", seed)
     trial.set_user_attr("run_dir", str(run_dir))
     monitor = TrialMonitor(trial)
-    if (run_dir / CHECKPOINT_DIR / "latest.pt").is_file():
-        trainer = Trainer.resume(run_dir, env_factory=env_factory)
-        for record in read_evaluations(run_dir):  # the earlier try's reports, on this trial
-            monitor.best = max(monitor.best, record["return_mean"])
-            trial.report(monitor.best, record["env_steps"])
-    else:
-        trainer = build_trainer(settings, params, run_dir, seed, env_factory)
+    trainer = Trainer.open(run_dir, trial_spec(settings, params, seed), tensorboard=True, env_factory=env_factory)
+    for record in read_evaluations(run_dir):  # a retry: the earlier try's reports, on this trial
+        monitor.best = max(monitor.best, record["return_mean"])
+        trial.report(monitor.best, record["env_steps"])
     try:
         trainer.train(progress=False, on_update=monitor)
     except (ValueError, RuntimeError) as error:

@@ -206,7 +206,7 @@ def test_a_negative_checkpoint_count_is_refused():
 
 
 def test_best_and_numbered_checkpoints_hold_the_policy_and_load_without_an_env(tmp_path, monkeypatch):
-    import roto.rl.runner as runner
+    import roto.rl.run_dir as runner
 
     trainer = tiny_trainer(tmp_path, "run", 2, extra=["run.eval_every=1", "run.checkpoint_every=1"])
     trainer.train(progress=False)

@@ -12,7 +12,7 @@ from optuna.trial import TrialState
 
 from roto.rl.config import load_agent_config
 from roto.rl.evaluation import read_evaluations
-from roto.rl.runner import CHECKPOINT_DIR
+from roto.rl.run_dir import CHECKPOINT_DIR
 from roto.sweep.report import export_best, show
 from roto.sweep.storage import REASON_ATTR, open_storage
 from roto.sweep.study import SEEDS, open_study

@@ -1,0 +1,62 @@
+"""A run directory's layout and its readers, in one place.
+
+``<run_dir>/config.yaml`` (``roto.rl.settings``), ``scalars.csv``, ``evaluations.jsonl``,
+``tensorboard/`` and ``checkpoints/``: ``latest.pt`` (everything a resume needs), ``best.pt`` and
+the numbered copies ``agent_<update>.pt`` (the policy only, ``POLICY_KEYS``). ``load_policy``
+reads any of them without building an env.
+"""
+
+from __future__ import annotations
+
+import pathlib
+
+from roto.envs.roto_env import RotoEnv
+from roto.rl.build import build_model, extra_groups, stacked_sizes
+from roto.rl.checkpoints import load_checkpoint
+from roto.rl.config import AgentConfig, from_dict
+from roto.rl.networks import ActorCritic
+from roto.rl.settings import TrainSettings
+
+CHECKPOINT_DIR = "checkpoints"
+POLICY_KEYS = ("model", "train", "agent", "obs_sizes", "num_actions", "update", "env_steps", "best_eval_return",
+               "last_eval")  # fmt: skip
+"""What a policy-only checkpoint holds: enough for ``load_policy``, ``roto eval`` and ``roto play``."""
+
+
+def checkpoint_path(run_dir: str | pathlib.Path, name: str = "latest") -> pathlib.Path:
+    """``<run_dir>/checkpoints/<name>.pt`` (``latest``, ``best`` or ``agent_<update>``)."""
+    return pathlib.Path(run_dir) / CHECKPOINT_DIR / f"{name}.pt"
+
+
+def numbered_checkpoints(run_dir: pathlib.Path) -> list[pathlib.Path]:
+    """The run's ``agent_<update>.pt`` copies, oldest first."""
+    paths = (run_dir / CHECKPOINT_DIR).glob("agent_*.pt")
+    return sorted((p for p in paths if p.stem[6:].isdigit()), key=lambda p: int(p.stem[6:]))
+
+
+def first_missing(path: pathlib.Path) -> pathlib.Path | None:
+    """The outermost of ``path`` and its parents that does not exist yet (None: ``path`` exists)."""
+    missing = None
+    for folder in (path, *path.parents):
+        if folder.exists():
+            break
+        missing = folder
+    return missing
+
+
+def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSettings, AgentConfig]:
+    """The policy stored in a checkpoint (on the CPU, in eval mode), with the run's settings."""
+    state = load_checkpoint(checkpoint)
+    settings = TrainSettings.from_dict(state["train"])
+    agent = from_dict(AgentConfig, state["agent"]).validate()
+    obs_mode = settings.env.obs_mode
+    if "obs_sizes" in state:
+        sizes, num_actions = {k: int(v) for k, v in state["obs_sizes"].items()}, int(state["num_actions"])
+    else:  # written before checkpoints carried their sizes: an env tells them
+        env = RotoEnv(settings.cpu_env_config(num_envs=1, extra_groups=extra_groups(agent, obs_mode)))
+        sizes, num_actions = stacked_sizes(env), env.num_actions
+        env.close()
+    model = build_model(sizes, num_actions, agent, obs_mode)
+    model.load_state_dict(state["model"])
+    model.eval()
+    return model, settings, agent

@@ -1,0 +1,78 @@
+"""What a training run is, built one way for every caller: ``roto train``, sweep trials and
+Olympiad cells.
+
+``build_run_spec`` turns a task, a robot, an obs mode, an agent config and ``section.key=value``
+overrides into a ``RunSpec``: ``env.<field>=value`` sets any env field but the task, robot, obs mode
+and the learner's extra groups (backend, device, seed, touch, num_envs, replayed starts ...); every
+other override changes the agent config. ``roto.rl.runner.Trainer.open`` then creates the run, or
+continues it when it already has a checkpoint.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from roto.envs.config import EnvConfig
+from roto.rl.config import AgentConfig, load_agent_config, to_dict
+from roto.rl.overrides import apply_env_overrides, split_overrides
+from roto.rl.settings import TrainSettings
+
+DEFAULT_STEPS = 1_000_000
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunSpec:
+    """A training run: its training envs, its agent and its env-step budget."""
+
+    env: EnvConfig
+    agent: AgentConfig
+    steps: int = DEFAULT_STEPS
+
+    @property
+    def settings(self) -> TrainSettings:
+        """The envs and budget as ``TrainSettings`` (what ``config.yaml``'s ``train`` section holds)."""
+        return TrainSettings(env=self.env, total_steps=self.steps)
+
+    def differences(self, other: RunSpec) -> dict[str, tuple[Any, Any]]:
+        """{dotted key: (this value, other's value)} where the two specs train differently (the
+        budget aside: a run may be extended)."""
+        mine = {"env": dataclasses.asdict(self.env), "agent": to_dict(self.agent)}
+        theirs = {"env": dataclasses.asdict(other.env), "agent": to_dict(other.agent)}
+        return {key: pair for key, pair in _flat_pairs(mine, theirs).items() if pair[0] != pair[1]}
+
+
+def _flat_pairs(a: dict[str, Any], b: dict[str, Any], prefix: str = "") -> dict[str, tuple[Any, Any]]:
+    pairs = {}
+    for key in sorted(set(a) | set(b)):
+        x, y = a.get(key), b.get(key)
+        if isinstance(x, dict) and isinstance(y, dict):
+            pairs.update(_flat_pairs(x, y, f"{prefix}{key}."))
+        else:
+            pairs[f"{prefix}{key}"] = (x, y)
+    return pairs
+
+
+def build_run_spec(
+    task: str,
+    robot: str = "shadow",
+    obs: str = "blind",
+    agent_cfg: str | None = None,
+    overrides: Sequence[str] = (),
+    steps: int = DEFAULT_STEPS,
+    **env_fields: Any,
+) -> RunSpec:
+    """The run ``task`` x ``robot`` x ``obs`` with agent config ``agent_cfg`` (a file, a packaged
+    name, or None: the task's default) and ``overrides``.
+
+    ``env_fields`` set env fields directly (the CLI's ``--num_envs``, ``--backend`` ... flags);
+    ``env.*`` overrides are applied after them, so an override wins over a flag. Everything is
+    validated here, before any directory or env exists.
+    """
+    env_changes, agent_overrides = split_overrides(list(overrides))
+    env = apply_env_overrides(EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields), env_changes)
+    agent = load_agent_config(task, agent_cfg, agent_overrides)
+    TrainSettings(env=env, total_steps=steps)  # checks the budget
+    return RunSpec(env=env, agent=agent, steps=steps)

@@ -1,0 +1,46 @@
+import pytest
+
+from roto.rl.run_spec import build_run_spec
+from roto.rl.runner import Trainer
+from tests.rl.toy_env import ToyEnv
+
+TINY = ["network.encoder=[16]", "network.policy_head=[8]", "network.value_head=[8]", "ppo.rollouts=4",
+        "ppo.epochs=1", "ppo.minibatches=1", "run.num_eval_envs=2"]  # fmt: skip
+
+
+def test_env_overrides_set_any_env_field_and_win_over_flags():
+    overrides = ["env.touch=force", "env.seed=7", "env.backend=warp", "ppo.lr=1e-3"]
+    spec = build_run_spec("bounce", "allegro", "state", "bounce_cpu", overrides, 64, num_envs=8, seed=1, touch="binary")
+    assert (spec.env.robot, spec.env.obs_mode, spec.env.num_envs) == ("allegro", "state", 8)
+    assert (spec.env.touch, spec.env.seed, spec.env.backend) == ("force", 7, "warp")
+    assert spec.agent.ppo.lr == 1e-3 and spec.agent.ppo.epochs == 5 and spec.steps == 64
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        (["env.task=baoding"], "unknown env key 'task'"),
+        (["env.backend=abacus"], "abacus"),
+        (["ppo.nosuch=1"], "unknown config key 'ppo.nosuch'"),
+    ],
+)
+def test_a_bad_spec_is_refused_before_anything_exists(overrides, message, tmp_path):
+    with pytest.raises(ValueError, match=message):
+        build_run_spec("bounce", overrides=overrides)
+
+
+def test_open_creates_then_continues_a_run_and_refuses_other_settings(tmp_path):
+    spec = build_run_spec("bounce", obs="proprio", overrides=TINY, steps=32, num_envs=4)
+    run = tmp_path / "run"
+    first = Trainer.open(run, spec, tensorboard=False, env_factory=ToyEnv)
+    assert first.update == 0
+    first.train(progress=False)
+    longer = build_run_spec("bounce", obs="proprio", overrides=TINY, steps=64, num_envs=4)
+    again = Trainer.open(run, longer, tensorboard=False, env_factory=ToyEnv)  # same run, a larger budget
+    assert again.update == 2 and again.settings.total_steps == 64
+    again.train(progress=False)
+    other = build_run_spec("bounce", obs="proprio", overrides=[*TINY, "ppo.lr=1e-3"], steps=64, num_envs=4)
+    with pytest.raises(ValueError, match=r"exists with other settings .*'agent.ppo.lr': \(0.001, 0.000259\)"):
+        Trainer.open(run, other, tensorboard=False, env_factory=ToyEnv)
+    with pytest.raises(FileNotFoundError):
+        Trainer.open(tmp_path / "nothing_here", tensorboard=False, env_factory=ToyEnv)
