@@ -28,6 +28,7 @@ from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import CHECKPOINT_DIR
 from roto.rl.run_spec import RunSpec, build_run_spec
 from roto.rl.runner import Trainer
+from roto.tasks import get_task
 
 
 def code_commit() -> str:
@@ -69,9 +70,12 @@ def run_cell(
     best = copy.deepcopy(final)
     best.load_state_dict(load_checkpoint(run_dir / CHECKPOINT_DIR / "best.pt")["model"])
     records = read_evaluations(run_dir)
+    entry = plan.variants[cell.variant].for_task(cell.task)
     summary = {
         **{key: getattr(cell, key) for key in ("task", "robot", "obs", "variant", "seed")},
+        "task_version": get_task(cell.task).version,
         "plan": plan.name,
+        "agent": {"label": entry.label, "roto_agent": entry.roto_agent},
         "commit": commit,
         "run_dir": str(run_dir),
         "env_steps": trainer.env_steps,

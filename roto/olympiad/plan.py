@@ -9,7 +9,7 @@ A plan is a YAML file::
     variants:               # name -> per task: agent config (a file or packaged name; null or
       ppo:                  #   left out: the task's default) and overrides (agent keys, and env.*
         bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004]}  # keys such as env.touch)
-        baoding: {overrides: [ppo.epochs=4]}
+        baoding: {overrides: [ppo.epochs=4], roto_agent: ppo}  # compared with roto v1's PPO
       force_touch:
         bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004, env.touch=force]}
     grids:                  # the cells: the union of these products
@@ -37,9 +37,29 @@ from roto.tasks import TASKS
 from roto.yaml_files import read_yaml
 
 PLAN_KEYS = {"description", "steps", "eval_episodes", "num_envs", "threads", "backend", "device", "variants", "grids"}
-VARIANT_KEYS = {"agent_cfg", "overrides"}
+VARIANT_KEYS = {"agent_cfg", "overrides", "roto_agent"}
 """Keys of a variant's entry for one task."""
+ROTO_AGENTS = ("ppo", "forward_dynamics", "forward_dynamics_memory")
+"""roto's published agents a variant may declare itself to be (``roto_agent``): its column then
+stands beside that agent's roto v1 figure in ``roto results``; a variant that declares none (a
+privileged critic, a swept config, another touch) stands beside none."""
 GRID_KEYS = {"tasks", "robots", "obs", "variants", "seeds"}
+
+
+@dataclass(frozen=True)
+class VariantTask:
+    """What a variant trains one task with."""
+
+    task: str
+    agent_cfg: str | None
+    overrides: tuple[str, ...]
+    roto_agent: str | None = None
+
+    @property
+    def label(self) -> str:
+        """The agent config and overrides, as a results table names them."""
+        changes = f" + {', '.join(self.overrides)}" if self.overrides else ""
+        return f"{self.agent_cfg or self.task}{changes}"
 
 
 @dataclass(frozen=True)
@@ -47,17 +67,21 @@ class Variant:
     """An agent: per task, its config (None: the task's default) and overrides."""
 
     name: str
-    per_task: tuple[tuple[str, str | None, tuple[str, ...]], ...]
-    """(task, agent config, overrides) for every task the variant trains."""
+    per_task: tuple[VariantTask, ...]
+
+    def for_task(self, task: str) -> VariantTask:
+        """What this variant trains ``task`` with."""
+        for entry in self.per_task:
+            if entry.task == task:
+                return entry
+        raise ValueError(
+            f"variant {self.name!r} has no config for task {task!r}; it has {[e.task for e in self.per_task]}"
+        )
 
     def agent_for(self, task: str) -> tuple[str | None, list[str]]:
         """(agent config, overrides) this variant trains ``task`` with."""
-        for name, agent_cfg, overrides in self.per_task:
-            if name == task:
-                return agent_cfg, list(overrides)
-        raise ValueError(
-            f"variant {self.name!r} has no config for task {task!r}; it has {[t[0] for t in self.per_task]}"
-        )
+        entry = self.for_task(task)
+        return entry.agent_cfg, list(entry.overrides)
 
 
 @dataclass(frozen=True, order=True)
@@ -144,9 +168,13 @@ def _variant(name: str, spec: Any, where: str) -> Variant:
     per_task = []
     for task, entry in spec.items():
         _check_keys(entry or {}, VARIANT_KEYS, f"{where}, task {task!r}")
-        overrides = tuple((entry or {}).get("overrides") or ())
+        entry = entry or {}
+        overrides = tuple(entry.get("overrides") or ())
         split_overrides(list(overrides))  # env keys checked here; their values with the cells' envs
-        per_task.append((task, (entry or {}).get("agent_cfg"), overrides))
+        roto_agent = entry.get("roto_agent")
+        if roto_agent is not None and roto_agent not in ROTO_AGENTS:
+            raise ValueError(f"{where}, task {task!r}: unknown roto_agent {roto_agent!r}; valid: {list(ROTO_AGENTS)}")
+        per_task.append(VariantTask(task, entry.get("agent_cfg"), overrides, roto_agent))
     return Variant(name, tuple(per_task))
 
 

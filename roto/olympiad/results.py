@@ -4,25 +4,27 @@ Per cell (task, robot, obs mode, variant) the score of a run (seed) is its polic
 (bounces or rotations per 10 s episode) averaged over the plan's evaluation episodes; the table
 gives the mean ± std over seeds and the interquartile mean with a 95 % stratified bootstrap
 interval (``roto.olympiad.stats``), for the final and for the best policy. Hands are rows, task ×
-obs mode × variant are columns, with the scripted Bounce reference of each hand
-(docs/robots.md) and roto v1's Shadow figures (docs/spec.md §9) beside them.
+obs mode × variant are columns, each named with the agent config it trained, with each task's
+reference of each hand (``Task.reference``) and roto v1's Shadow figures (docs/spec.md §9) beside the
+variants that declare themselves roto's agent.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import pathlib
 from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 
 from roto.eval.plots import plot_variants
+from roto.olympiad.plan import load_plan
 from roto.olympiad.stats import iqm, probability_of_improvement, stratified_bootstrap_ci
 from roto.result_files import read_json, replacing, write_text_atomic
+from roto.tasks import get_task
 
-METRIC = {"bounce": "bounces", "baoding": "rotations"}
-SCRIPTED_BOUNCE = {"shadow": 27.9, "shadow_lite": 9.5, "allegro": 11.8, "orca": 12.0}
-"""Bounces per 10 s episode of each hand's scripted Bounce policy (docs/robots.md)."""
 ROTO_V1_SHADOW = {
     ("bounce", "blind", "ppo"): 69.0,
     ("bounce", "proprio", "ppo"): 53.0,
@@ -33,10 +35,32 @@ ROTO_V1_SHADOW = {
     ("baoding", "blind", "forward_dynamics"): 9.9,
     ("baoding", "blind", "forward_dynamics_memory"): 17.4,
 }
-"""roto v1 on the Shadow hand after 200 M steps, mean of 5 seeds, by (task, obs mode, variant name)
-(docs/spec.md §9)."""
+"""roto v1 on the Shadow hand after 200 M steps, mean of 5 seeds, by (task, obs mode, roto's agent)
+(docs/spec.md §9): set only beside a variant that declares itself that agent (``roto_agent``)."""
 
 Key = tuple[str, str, str, str]  # task, robot, obs, variant
+Agents = dict[tuple[str, str], dict[str, Any]]
+"""{(task, variant): {"label": the agent config and overrides, "roto_agent": roto's agent or None}}."""
+
+
+def metric(task: str) -> str:
+    """The task's headline metric (``Task.headline_metric``)."""
+    return get_task(task).headline_metric
+
+
+def variant_agents(summaries: list[dict], plan: str = "") -> Agents:
+    """What each (task, variant) trained: from the plan when ``plan`` names a packaged plan or a
+    file, else from the summaries (which record it), else only the variant's name."""
+    agents: Agents = {}
+    for s in summaries:
+        agents.setdefault((s["task"], s["variant"]), s.get("agent") or {"label": "", "roto_agent": None})
+        if s.get("task_version") != get_task(s["task"]).version:  # trained on another (or an unrecorded) version
+            agents[(s["task"], "")] = {"stale": True}
+    with contextlib.suppress(ValueError, FileNotFoundError):
+        for name, variant in load_plan(plan).variants.items() if plan else ():
+            for entry in variant.per_task:
+                agents[(entry.task, name)] = {"label": entry.label, "roto_agent": entry.roto_agent}
+    return agents
 
 
 def read_summaries(folder: str | pathlib.Path) -> list[dict]:
@@ -52,7 +76,7 @@ def scores_by_cell(summaries: Iterable[dict], policy: str = "final") -> dict[Key
     found: dict[Key, list[tuple[int, float]]] = {}
     for s in summaries:
         key = (s["task"], s["robot"], s["obs"], s["variant"])
-        found.setdefault(key, []).append((s["seed"], s[policy][f"{METRIC[s['task']]}_mean"]))
+        found.setdefault(key, []).append((s["seed"], s[policy][f"{metric(s['task'])}_mean"]))
     return {key: np.array([score for _, score in sorted(runs)]) for key, runs in sorted(found.items())}
 
 
@@ -73,21 +97,37 @@ def improvements(scores: dict[Key, np.ndarray]) -> list[tuple[str, str, str, str
     return out
 
 
-def markdown_table(scores: dict[Key, np.ndarray]) -> str:
-    """Hands as rows, (task, obs, variant) as columns; scripted and roto v1 references beside."""
+def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None) -> str:
+    """Hands as rows, (task, obs, variant: its agent) as columns; each task's reference (``Task.reference``)
+    and roto v1's figure beside the variants that declare themselves roto's agent."""
+    agents = agents or {}
     columns = sorted({(task, obs, variant) for task, _, obs, variant in scores})
-    robots = sorted({robot for _, robot, _, _ in scores}, key=lambda r: list(SCRIPTED_BOUNCE).index(r))
-    head = ["hand", *(f"{t} / {o} / {v}" for t, o, v in columns), "scripted Bounce"]
+    tasks = sorted({task for task, _, _ in columns})
+    order = list(get_task("bounce").reference)
+    robots = sorted({robot for _, robot, _, _ in scores}, key=lambda r: order.index(r) if r in order else len(order))
+
+    current = [t for t in tasks if (t, "") not in agents]  # every summary of the task's current version
+
+    def header(task: str, obs: str, variant: str) -> str:
+        label = agents.get((task, variant), {}).get("label")
+        version = f"v{get_task(task).version}" if task in current else "older or unrecorded version"
+        return f"{task} ({version}) / {obs} / {variant}" + (f": {label}" if label else "")
+
+    head = ["hand", *(header(*column) for column in columns)]
+    head += [f"{get_task(t).reference_name} ({metric(t)}, v{get_task(t).version})" for t in current]
+    tasks = current  # a reference stands only beside scores of the task it was measured on
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for robot in robots:
-        cells = []
-        for task, obs, variant in columns:
-            runs = scores.get((task, robot, obs, variant))
-            stats = cell_statistics(runs) if runs is not None else None
-            cells.append(_format(stats))
-        lines.append("| " + " | ".join([robot, *cells, f"{SCRIPTED_BOUNCE[robot]}"]) + " |")
-    reference = [f"{ROTO_V1_SHADOW[column]}" if column in ROTO_V1_SHADOW else "" for column in columns]
-    lines.append("| " + " | ".join(["roto v1, Shadow, 200 M steps (5 seeds)", *reference, ""]) + " |")
+        cells = [_format(cell_statistics(scores[key]) if (key := (t, robot, o, v)) in scores else None)
+                 for t, o, v in columns]  # fmt: skip
+        refs = [f"{get_task(t).reference[robot]}" if robot in get_task(t).reference else "" for t in tasks]
+        lines.append("| " + " | ".join([robot, *cells, *refs]) + " |")
+    reference = []
+    for task, obs, variant in columns:
+        roto_agent = agents.get((task, variant), {}).get("roto_agent")
+        figure = ROTO_V1_SHADOW.get((task, obs, roto_agent)) if roto_agent else None
+        reference.append(f"{figure} ({roto_agent})" if figure is not None else "")
+    lines.append("| " + " | ".join(["roto v1, Shadow, 200 M steps (5 seeds)", *reference, *[""] * len(tasks)]) + " |")
     return "\n".join(lines)
 
 
@@ -106,7 +146,7 @@ def write_csv(scores: dict[Key, np.ndarray], path: pathlib.Path, policy: str) ->
                          "iqm_ci95_low", "iqm_ci95_high", "scores"])  # fmt: skip
         for (task, robot, obs, variant), runs in scores.items():
             s = cell_statistics(runs)
-            writer.writerow([policy, task, robot, obs, variant, METRIC[task], s["n"], s["mean"], s["std"], s["iqm"],
+            writer.writerow([policy, task, robot, obs, variant, metric(task), s["n"], s["mean"], s["std"], s["iqm"],
                              s["iqm_low"], s["iqm_high"], " ".join(f"{v:.4g}" for v in runs)])  # fmt: skip
 
 
@@ -120,7 +160,7 @@ def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pa
     paths = []
     for (task, robot), curves in groups.items():
         path = out / f"curves_{task}_{robot}.png"
-        plot_variants(curves, METRIC[task], path, title=f"{task} / {robot} ({label})", xs=("env_steps", "train_wall_s"))
+        plot_variants(curves, metric(task), path, title=f"{task} / {robot} ({label})", xs=("env_steps", "train_wall_s"))
         paths.append(path)
     return paths
 
@@ -132,12 +172,13 @@ def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str
     out.mkdir(parents=True, exist_ok=True)
     commits = sorted({s["commit"] for s in summaries})
     label = f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
+    agents = variant_agents(summaries, plan or summaries[0].get("plan", ""))
     md = [f"# Olympiad results ({label})", ""]
     for policy in ("final", "best"):
         scores = scores_by_cell(summaries, policy)
         write_csv(scores, out / f"results_{policy}.csv", policy)
         heading = f"## {policy} policy: task metric per 10 s episode, mean ± std over seeds"
-        md += [heading, "", markdown_table(scores), ""]
+        md += [heading, "", markdown_table(scores, agents), ""]
     pairs = improvements(scores_by_cell(summaries, "final"))
     if pairs:
         md += ["## Probability of improvement (final policies)", ""]

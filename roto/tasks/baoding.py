@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import mujoco
 import numpy as np
@@ -129,6 +130,11 @@ class Baoding:
     """v1: balls dropped from above, roto's diagonal (or side-by-side) targets; v0 started the balls
     on targets where they rest, partly inside the hand."""
     metric_names = ("swaps", "rotations")
+    headline_metric = "rotations"
+    reference_name = "reference controller"
+    reference = MappingProxyType({"shadow": 7.31, "shadow_lite": 5.50, "allegro": 5.03, "orca": 5.78})
+    """Rotations per 10 s of the predictive-sampling reference controller, 16 episodes each,
+    ``roto demo --task baoding`` (docs/robots.md)."""
     observation_size = 8
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:

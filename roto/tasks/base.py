@@ -8,6 +8,7 @@ code: it uses operators, indexing, ``sum``/``any``/``all(axis=...)`` and ``roto.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -72,6 +73,13 @@ class Task(Protocol):
     version: int
     """The Gymnasium id's version, bumped whenever dynamics, rewards, observations or terminations change."""
     metric_names: tuple[str, ...]
+    headline_metric: str
+    """The metric results tables rank agents by (one of ``metric_names``, per 10 s episode)."""
+    reference_name: str
+    """What ``reference`` is (a scripted policy, a controller)."""
+    reference: Mapping[str, float]
+    """{robot: the reference's ``headline_metric``}, measured (docs/robots.md): what a learned agent
+    is set beside."""
     observation_size: int
     """Features per world of ``observation`` (the ``task`` observation group holds one more: time left)."""
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import torch
 
@@ -65,6 +66,10 @@ class Bounce:
     display_name = "Bounce"
     version = 0
     metric_names = ("bounces",)
+    headline_metric = "bounces"
+    reference_name = "scripted Bounce"
+    reference = MappingProxyType({"shadow": 27.9, "shadow_lite": 9.5, "allegro": 11.8, "orca": 12.0})
+    """Bounces per 10 s of each hand's scripted policy, ``roto demo`` (docs/robots.md)."""
     observation_size = 3
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:

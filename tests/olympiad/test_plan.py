@@ -4,7 +4,7 @@ from roto.olympiad.plan import load_plan, packaged_plans
 
 
 def test_packaged_plans():
-    assert set(packaged_plans()) == {"cpu", "paper"}
+    assert set(packaged_plans()) == {"cpu", "paper", "variants_bounce", "variants_baoding"}
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
     assert len(names) == 16 and cpu.steps == 5_000_000 and cpu.eval_episodes == 100
@@ -36,6 +36,9 @@ VARIANTS = "variants:\n  ppo:\n    bounce: {agent_cfg: bounce_cpu_quickstart}\n"
         (VARIANTS.replace("quickstart}", "quickstart, overrides: [ppo.lrr=1]}") + GRID, r"key 'ppo.lrr'"),
         (VARIANTS.replace("bounce_cpu_quickstart", "bounce_fd") + GRID, r"packaged config: \['baoding'"),
         (VARIANTS, r"has no cells"),
+        (VARIANTS.replace("quickstart}", "quickstart, overrides: [env.task=x]}") + GRID, r"unknown env key 'task'"),
+        (VARIANTS.replace("quickstart}", "quickstart, overrides: [env.touch=smell]}") + GRID, r"smell"),
+        (VARIANTS.replace("quickstart}", "quickstart, roto_agent: sac}") + GRID, r"unknown roto_agent 'sac'"),
     ],
 )  # fmt: skip
 def test_a_bad_plan_is_rejected_naming_the_valid_choices(tmp_path, text, message):
@@ -54,7 +57,7 @@ def test_cli_rejects_a_bad_plan_before_anything_runs(tmp_path, capsys):
     assert "unknown robot 'r2d2'" in capsys.readouterr().err
     assert not (tmp_path / "runs").exists()
     assert main(["olympiad", "nope"]) == 2
-    assert "packaged plan: ['cpu', 'paper']" in capsys.readouterr().err
+    assert "packaged plan: ['cpu', 'paper', 'variants_baoding', 'variants_bounce']" in capsys.readouterr().err
 
 
 def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp_path, capsys):
@@ -72,3 +75,19 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     # 15 cells left x 5 M steps at 5000 env steps/s = 15000 s
     assert "1 done, 15 left; time left: 4.2 h for one worker at 5000 env steps/s" in out
     assert not (tmp_path / "cpu").exists()  # a dry run creates no study
+
+
+def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():
+    from roto.olympiad.cell import cell_spec
+    from roto.olympiad.plan import Cell
+
+    plan = load_plan("variants_bounce")
+    force = cell_spec(plan, Cell("bounce", "shadow", "blind", "force_touch", 1))
+    binary = cell_spec(plan, Cell("bounce", "shadow", "blind", "ppo", 1))
+    assert force.env.touch == "force" and binary.env.touch == "binary" and force.env.seed == 1
+    assert force.agent == binary.agent and force.agent.ppo.entropy_coef == 0.004
+    assert (
+        plan.variants["force_touch"].for_task("bounce").label == "bounce_cpu + ppo.entropy_coef=0.004, env.touch=force"
+    )
+    assert load_plan("paper").variants["ppo"].for_task("bounce").roto_agent == "ppo"
+    assert load_plan("cpu").variants["ppo"].for_task("bounce").roto_agent is None  # the swept critic is not roto's PPO

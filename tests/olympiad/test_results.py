@@ -13,6 +13,9 @@ CELLS = [  # (task, robot, variant, seed, final metric, best metric)
 ]
 
 
+AGENTS = {"ppo": {"label": "roto's PPO", "roto_agent": "ppo"}, "fd": {"label": "a swept FD", "roto_agent": None}}
+
+
 def write_summaries(folder):
     folder.mkdir()
     for task, robot, variant, seed, final, best in CELLS:
@@ -21,7 +24,8 @@ def write_summaries(folder):
                   f"{metric}_mean": final * u / 2} for u in (1, 2)]  # fmt: skip
         summary = {"task": task, "robot": robot, "obs": "blind", "variant": variant, "seed": seed, "plan": "toy",
                    "commit": "abc1234", "env_steps": 2000, "train_wall_s": 4.0, "evaluations": curve,
-                   "final": {f"{metric}_mean": final}, "best": {f"{metric}_mean": best}}  # fmt: skip
+                   "final": {f"{metric}_mean": final}, "best": {f"{metric}_mean": best},
+                   "agent": AGENTS[variant], "task_version": {"bounce": 0, "baoding": 1}[task]}  # fmt: skip
         (folder / f"{task}-{robot}-blind-{variant}-seed{seed}.json").write_text(json.dumps(summary))
 
 
@@ -41,8 +45,10 @@ def test_results_match_hand_computed_statistics(tmp_path, capsys):
     md = (out / "results.md").read_text()
     assert "plan toy, commit abc1234" in md
     assert "| shadow | " in md and "40.0 ± 35.4 (IQM 25.0" in md and "| 27.9 |" in md  # scripted Bounce beside
-    # roto v1's figures where the variant is roto's: baoding / blind / ppo, bounce / blind / ppo (not "fd")
-    assert "| roto v1, Shadow, 200 M steps (5 seeds) | 5.1 |  | 69.0 |  |" in md
+    # every column names its agent; roto v1's figures only where the variant declares itself roto's agent
+    assert "| bounce (v0) / blind / fd: a swept FD | bounce (v0) / blind / ppo: roto's PPO |" in md
+    assert "| roto v1, Shadow, 200 M steps (5 seeds) | 5.1 (ppo) |  | 69.0 (ppo) |  |  |" in md
+    assert "| reference controller (rotations, v1) | scripted Bounce (bounces, v0) |" in md
     # P(fd > ppo) on Shadow Bounce: 25 beats 10 and 20, 35 beats 10, 20 and 30: 5 of 8 pairs
     assert "bounce / shadow / blind: P(fd > ppo) = 0.62" in md
     assert (out / "curves_bounce_shadow.png").stat().st_size > 0 and (out / "curves_baoding_allegro.png").is_file()
