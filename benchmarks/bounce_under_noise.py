@@ -22,7 +22,7 @@ from collections.abc import Callable
 
 import torch
 
-from roto.eval.episodes import first_episodes
+from roto.envs.episodes import first_episodes
 from roto.registry import make
 from roto.scripted import SCRIPTS, ScriptedBounce
 

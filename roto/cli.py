@@ -128,6 +128,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
 
     import torch
 
+    from roto.eval.plots import plot_learning_curve
     from roto.rl.run_spec import DEFAULT_STEPS, build_run_spec
     from roto.rl.runner import Trainer
     from roto.rl.settings import CONFIG_NAME
@@ -160,6 +161,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         trainer = Trainer.open(run_dir, spec, wandb_project=wandb_project)
     print(f"run directory: {trainer.run_dir}", file=sys.stderr)
     last = trainer.train(progress=not args.no_progress)
+    plot_learning_curve(trainer.run_dir)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
     summary.update({k.removeprefix("eval/"): v for k, v in last.items()})
     summary["settings"] = trainer.settings.to_dict()

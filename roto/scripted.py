@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 import torch
 
 from roto.envs.control import target_to_action
+from roto.envs.episodes import first_episodes
 from roto.envs.roto_env import RotoEnv
-from roto.eval.episodes import first_episodes
 from roto.registry import make
 
 HOLD, WIND_UP, STRIKE = 0, 1, 2

@@ -35,3 +35,31 @@ def test_no_function_is_over_60_lines():
                 if lines > MAX_FUNCTION_LINES:
                     too_long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name} is {lines} lines")
     assert not too_long, f"functions over {MAX_FUNCTION_LINES} lines:\n" + "\n".join(too_long)
+
+
+LAYERS = {
+    "envs": ("roto.rl", "roto.eval", "roto.sweep", "roto.olympiad"),
+    "rl": ("roto.eval", "roto.sweep", "roto.olympiad"),
+}
+"""Packages and what they must never import: data flows up, from the envs to the learner to what
+evaluates, sweeps and tabulates it."""
+
+
+def imported_modules(path: pathlib.Path) -> set[str]:
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            names.add(node.module)
+        elif isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+    return names
+
+
+def test_lower_layers_never_import_higher_ones():
+    wrong = []
+    for package, forbidden in LAYERS.items():
+        for path in sorted((ROOT / package).rglob("*.py")):
+            wrong += [
+                f"{path.relative_to(ROOT)} imports {m}" for m in imported_modules(path) if m.startswith(forbidden)
+            ]
+    assert not wrong, wrong

@@ -9,8 +9,8 @@ from typing import Any
 import torch
 
 from roto.envs.config import EnvConfig
+from roto.envs.episodes import first_episodes
 from roto.envs.roto_env import RotoEnv
-from roto.eval.episodes import first_episodes
 from roto.rl.networks import ActorCritic
 from roto.rl.settings import TrainSettings
 from roto.rl.torch_threads import single_torch_thread

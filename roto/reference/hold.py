@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import torch
 
-from roto.eval.episodes import first_episodes
+from roto.envs.episodes import first_episodes
 from roto.registry import make
 
 

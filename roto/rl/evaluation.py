@@ -15,7 +15,7 @@ from typing import Any
 
 import torch
 
-from roto.eval.episodes import first_episodes
+from roto.envs.episodes import first_episodes
 from roto.result_files import write_text_atomic
 from roto.rl.networks import ActorCritic
 from roto.rl.torch_threads import single_torch_thread

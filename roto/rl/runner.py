@@ -186,10 +186,6 @@ class Trainer:
             if self._lock is not None:  # the run is free for a resume once training stops
                 self._lock.close()
                 self._lock = None
-        if self.tensorboard:
-            from roto.eval.plots import plot_learning_curve
-
-            plot_learning_curve(self.run_dir)
         return dict(self.last_eval)
 
     def _open_logger(self) -> ScalarLogger:

@@ -1,7 +1,7 @@
 import torch
 
 from roto.envs.config import EnvConfig
-from roto.eval.episodes import first_episodes
+from roto.envs.episodes import first_episodes
 from tests.rl.toy_env import EPISODE_STEPS, ToyEnv
 
 
