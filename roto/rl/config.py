@@ -113,7 +113,9 @@ class RunConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class AgentConfig:
-    """Everything that defines the learner."""
+    """Everything that defines the learner. The defaults are roto's Bounce agent (docs/spec.md §7):
+    the one place its numbers live; ``roto/configs/bounce.yaml`` names them, every other packaged
+    config is a diff."""
 
     network: NetworkConfig = field(default_factory=NetworkConfig)
     ppo: PPOConfig = field(default_factory=PPOConfig)

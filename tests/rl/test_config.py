@@ -147,3 +147,14 @@ def test_a_bad_extends_is_a_clear_error(tmp_path, files, message):
         (tmp_path / name).write_text(text)
     with pytest.raises(ValueError, match=message):
         load_agent_config("bounce", tmp_path / "a.yaml")
+
+
+def test_roto_bounce_numbers_live_in_the_config_classes_and_baoding_is_a_diff():
+    import yaml
+
+    assert load_agent_config("bounce") == AgentConfig()
+    shipped = packaged_configs()
+    bounce = yaml.safe_load(shipped["bounce"].read_text())
+    assert bounce == {"network": {}}  # names the defaults, repeats no number
+    baoding = yaml.safe_load(shipped["baoding"].read_text())
+    assert baoding["extends"] == "bounce" and "gamma" not in baoding["ppo"]  # only what differs
