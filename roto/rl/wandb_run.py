@@ -13,6 +13,9 @@ from typing import Any
 
 import yaml
 
+from roto.result_files import write_text_atomic
+from roto.yaml_files import read_yaml
+
 WANDB_FILE = "wandb.yaml"
 
 
@@ -22,10 +25,18 @@ def require_wandb() -> None:
         raise ValueError("logging to Weights & Biases needs wandb, which is not installed: pip install -e '.[wandb]'")
 
 
+def read_wandb_file(path: pathlib.Path) -> dict[str, Any]:
+    """``wandb.yaml``'s project and run id; ValueError naming the file when it is malformed."""
+    data = read_yaml(path, "W&B run file")
+    if not isinstance(data, dict) or not {"project", "id"} <= data.keys():
+        raise ValueError(f"W&B run file {str(path)!r} must hold 'project' and 'id', got {data!r}")
+    return data
+
+
 def logged_wandb_project(run_dir: pathlib.Path) -> str | None:
     """The W&B project ``run_dir`` logs to (None: it does not log to W&B)."""
     path = run_dir / WANDB_FILE
-    return yaml.safe_load(path.read_text())["project"] if path.is_file() else None
+    return read_wandb_file(path)["project"] if path.is_file() else None
 
 
 def open_wandb_run(run_dir: pathlib.Path, project: str, config: dict[str, Any]) -> Any:
@@ -33,9 +44,9 @@ def open_wandb_run(run_dir: pathlib.Path, project: str, config: dict[str, Any]) 
     import wandb
 
     path = run_dir / WANDB_FILE
-    stored = yaml.safe_load(path.read_text()) if path.is_file() else {"project": project, "id": None}
+    stored = read_wandb_file(path) if path.is_file() else {"project": project, "id": None}
     run = wandb.init(
         project=stored["project"], id=stored["id"], name=run_dir.name, dir=run_dir, config=config, resume="allow"
     )
-    path.write_text(yaml.safe_dump({"project": run.project, "id": run.id}, sort_keys=False))
+    write_text_atomic(path, yaml.safe_dump({"project": run.project, "id": run.id}, sort_keys=False))
     return run
