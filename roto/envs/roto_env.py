@@ -64,7 +64,10 @@ class RotoEnv:
         self.groups = tuple(group for group in OBS_GROUPS if group in wanted)
         self.balls = self.task.balls(self.robot)
         self.model, self.layout = build_scene(self.robot, self.balls, config.touch)
-        nconmax, njmax = warp_capacity(config.robot, config.task)
+        capacity = {}
+        if config.backend == "warp":  # fixed per-world buffers: roto's measured figures unless given
+            nconmax, njmax = warp_capacity(config.robot, config.task)
+            capacity = {"nconmax": config.nconmax or nconmax, "njmax": config.njmax or njmax}
         self.backend = make_backend(
             config.backend,
             self.model,
@@ -72,8 +75,7 @@ class RotoEnv:
             substeps=config.substeps,
             threads=config.threads,
             device=config.device,
-            nconmax=config.nconmax or nconmax,
-            njmax=config.njmax or njmax,
+            **capacity,
         )
         self._generator = torch.Generator(device=self.device)
         self._generator.manual_seed(config.seed)
