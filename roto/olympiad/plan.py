@@ -12,6 +12,8 @@ A plan is a YAML file::
         baoding: {overrides: [ppo.epochs=4], roto_agent: ppo}  # compared with roto v1's PPO
       force_touch:
         bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004, env.touch=force]}
+      replayed:             # {robot} in an override becomes each cell's hand
+        baoding: {overrides: ["env.replay_starts=starts/{robot}.npz", env.replay_share=0.25]}
     grids:                  # the cells: the union of these products
       - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0, 1]}
 
@@ -44,6 +46,8 @@ ROTO_AGENTS = ("ppo", "forward_dynamics", "forward_dynamics_memory")
 stands beside that agent's roto v1 figure in ``roto results``; a variant that declares none (a
 privileged critic, a swept config, another touch) stands beside none."""
 GRID_KEYS = {"tasks", "robots", "obs", "variants", "seeds"}
+ROBOT_FIELD = "{robot}"
+"""Written in a variant's override, replaced by each cell's robot name."""
 
 
 @dataclass(frozen=True)
@@ -78,10 +82,12 @@ class Variant:
             f"variant {self.name!r} has no config for task {task!r}; it has {[e.task for e in self.per_task]}"
         )
 
-    def agent_for(self, task: str) -> tuple[str | None, list[str]]:
-        """(agent config, overrides) this variant trains ``task`` with."""
+    def agent_for(self, task: str, robot: str | None = None) -> tuple[str | None, list[str]]:
+        """(agent config, overrides) this variant trains ``task`` with; with ``robot``, ``{robot}``
+        in an override becomes the robot's name (a per-hand file, e.g. replayed starts)."""
         entry = self.for_task(task)
-        return entry.agent_cfg, list(entry.overrides)
+        overrides = [o.replace(ROBOT_FIELD, robot) for o in entry.overrides] if robot else list(entry.overrides)
+        return entry.agent_cfg, overrides
 
 
 @dataclass(frozen=True, order=True)
@@ -194,7 +200,7 @@ def _grid_cells(grid: Any, variants: dict[str, Variant], where: str) -> list[Cel
             raise ValueError(f"{where}: seeds must be integers >= 0, got {seed!r}")
     for task, robot, obs, name in itertools.product(grid["tasks"], grid["robots"], grid["obs"], grid["variants"]):
         try:  # the variant's config and env overrides must hold for this pair and obs mode (groups included)
-            spec = build_run_spec(task, robot, obs, *variants[name].agent_for(task))
+            spec = build_run_spec(task, robot, obs, *variants[name].agent_for(task, robot))
             resolve_groups(spec.agent, obs)
         except (ValueError, FileNotFoundError) as error:
             raise ValueError(f"{where}: variant {name!r} on {task}/{robot}/{obs}: {error}") from None

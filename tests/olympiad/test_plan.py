@@ -1,10 +1,12 @@
+import pathlib
+
 import pytest
 
 from roto.olympiad.plan import load_plan, packaged_plans
 
 
 def test_packaged_plans():
-    assert set(packaged_plans()) == {"cpu", "paper", "variants_bounce", "variants_baoding"}
+    assert set(packaged_plans()) == {"cpu", "paper", "variants_bounce", "variants_baoding", "baoding_v1_cpu"}
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
     assert len(names) == 16 and cpu.steps == 5_000_000 and cpu.eval_episodes == 100
@@ -57,7 +59,10 @@ def test_cli_rejects_a_bad_plan_before_anything_runs(tmp_path, capsys):
     assert "unknown robot 'r2d2'" in capsys.readouterr().err
     assert not (tmp_path / "runs").exists()
     assert main(["olympiad", "nope"]) == 2
-    assert "packaged plan: ['cpu', 'paper', 'variants_baoding', 'variants_bounce']" in capsys.readouterr().err
+    assert (
+        "packaged plan: ['baoding_v1_cpu', 'cpu', 'paper', 'variants_baoding', 'variants_bounce']"
+        in capsys.readouterr().err
+    )
 
 
 def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp_path, capsys):
@@ -91,3 +96,17 @@ def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agent
     )
     assert load_plan("paper").variants["ppo"].for_task("bounce").roto_agent == "ppo"
     assert load_plan("cpu").variants["ppo"].for_task("bounce").roto_agent is None  # the swept critic is not roto's PPO
+
+
+def test_robot_in_an_override_becomes_each_cells_hand():
+    from roto.olympiad.cell import cell_spec
+    from roto.olympiad.plan import Cell
+
+    plan = load_plan("baoding_v1_cpu")
+    for robot in ("shadow", "orca"):
+        spec = cell_spec(plan, Cell("baoding", robot, "blind", "task_critic_replay", 1))
+        assert spec.env.replay_starts == f"benchmarks/results/baoding_reference/{robot}_preswap.npz"
+        assert spec.env.replay_share == 0.25 and spec.agent.ppo.epochs == 4 and spec.env.threads == 2
+    assert all(
+        pathlib.Path(f"benchmarks/results/baoding_reference/{c.robot}_preswap.npz").is_file() for c in plan.cells
+    )
