@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import pathlib
 
 import optuna
@@ -9,7 +10,7 @@ import yaml
 from optuna.trial import TrialState
 
 from roto.result_files import write_text_atomic
-from roto.rl.config import load_agent_config, to_dict
+from roto.rl.config import load_agent_config, packaged_configs, to_dict
 from roto.rl.overrides import split_overrides
 from roto.sweep.space import as_overrides
 from roto.sweep.storage import REASON_ATTR, RETRY_OF_ATTR
@@ -20,7 +21,8 @@ def export_best(
     name: str, root: str, storage_url: str | None, out: str | pathlib.Path, number: int | None = None
 ) -> dict:
     """Write the best complete trial's agent config (or trial ``number``'s, a complete one) to ``out``
-    (YAML ``roto train --agent_cfg`` loads).
+    (YAML ``roto train --agent_cfg`` loads), as a diff: ``extends:`` the study's base config, then
+    only what the trial changes (the searched values and the study's fixed agent overrides).
 
     Env parameters of the trial (``env.*``) are not agent settings: the file's header gives the
     ``roto train`` command with them. Returns a summary of the trial.
@@ -50,8 +52,33 @@ def export_best(
     ]
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(path, "\n".join(header) + "\n" + yaml.safe_dump(to_dict(agent), sort_keys=False))
+    base = settings["agent_cfg"] or settings["task"]
+    changes = changed_keys(to_dict(load_agent_config(settings["task"], settings["agent_cfg"])), to_dict(agent))
+    body = {"extends": extends_name(base, path), **changes}  # the trial as a diff from the study's base config
+    write_text_atomic(path, "\n".join(header) + "\n" + yaml.safe_dump(body, sort_keys=False))
     return {"study": name, "trial": best.number, "value": best.value, "params": best.params, "out": str(path)}
+
+
+def changed_keys(base: dict, config: dict) -> dict:
+    """The parts of nested dict ``config`` that differ from ``base`` (sections kept only where
+    something in them changed)."""
+    changes = {}
+    for key, value in config.items():
+        if isinstance(value, dict) and isinstance(base.get(key), dict):
+            inner = changed_keys(base[key], value)
+            if inner:
+                changes[key] = inner
+        elif base.get(key, object()) != value:
+            changes[key] = value
+    return changes
+
+
+def extends_name(base: str, out: pathlib.Path) -> str:
+    """How a config written to ``out`` names its base: a packaged name as it is, a file by its
+    path relative to ``out``'s folder."""
+    if base in packaged_configs():
+        return base
+    return os.path.relpath(pathlib.Path(base).resolve(), out.resolve().parent)
 
 
 def trials_table(study: optuna.Study) -> str:

@@ -76,3 +76,16 @@ def test_cli_rejects_a_bad_space_before_any_trial_runs(tmp_path, capsys):
     assert code == 2
     assert "'ppo.lr': low > high" in capsys.readouterr().err
     assert not (tmp_path / "bad").exists()  # no study was created, no trial ran
+
+
+def test_an_exported_config_names_a_file_base_relative_to_itself(tmp_path):
+    from roto.sweep.report import changed_keys, extends_name
+
+    (tmp_path / "configs").mkdir()
+    base = tmp_path / "configs" / "mine.yaml"
+    base.write_text("extends: bounce\n")
+    assert extends_name("bounce_cpu", tmp_path / "out" / "x.yaml") == "bounce_cpu"
+    assert extends_name(str(base), tmp_path / "out" / "x.yaml") == "../configs/mine.yaml"
+    assert changed_keys({"ppo": {"lr": 1, "gamma": 2}, "ssl": {}}, {"ppo": {"lr": 3, "gamma": 2}, "ssl": {}}) == {
+        "ppo": {"lr": 3}
+    }

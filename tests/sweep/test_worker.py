@@ -58,6 +58,9 @@ def test_a_four_trial_toy_sweep_completes_and_exports_a_loadable_config(tmp_path
     assert agent.ppo.lr == best.params["ppo.lr"] and agent.ppo.epochs == best.params["ppo.epochs"]
     assert agent.network.encoder == (16,) and agent.ppo.rollouts == 4  # the study's fixed overrides too
     assert f"env.action_smoothing={best.params['env.action_smoothing']}" in out.read_text()
+    exported = yaml.safe_load(out.read_text())  # a diff: the base, then only what the trial changes
+    assert exported["extends"] == "bounce" and "gamma" not in exported["ppo"] and "run" in exported
+    assert exported["ppo"]["lr"] == best.params["ppo.lr"] and exported["network"]["encoder"] == [16]
     other = next(t for t in study.get_trials(states=(TrialState.COMPLETE,)) if t.number != best.number)
     export_best(settings.study, settings.root, None, out, other.number)  # a chosen trial instead of the best
     assert load_agent_config("bounce", out).ppo.lr == other.params["ppo.lr"]
