@@ -63,7 +63,7 @@ def run_policy(robot: str, policy: str, envs: int, seed: int) -> dict[str, float
     }[name]
     act = noisy(base, noise_std, generator) if noise_std else base
     result = first_episodes(env, act, obs, 1, on_done=scripted.reset)
-    return {"length": float(result["l"].mean()), "bounces": float(result["bounces"].mean())}
+    return {"length": float(result["length"].mean()), "bounces": float(result["bounces"].mean())}
 
 
 def main() -> None:

@@ -219,5 +219,5 @@ def run_scripted_bounce(
         "mean_bounces": float(bounces.mean()),
         "min_bounces": float(bounces.min()),
         "max_bounces": float(bounces.max()),
-        "mean_length": float(result["l"].mean()),
+        "mean_length": float(result["length"].mean()),
     }

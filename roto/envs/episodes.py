@@ -8,6 +8,15 @@ from typing import Any
 import torch
 from tqdm import tqdm
 
+EPISODE_NAMES = {"r": "return", "l": "length"}
+"""``info["episode"]``'s Gymnasium keys (``RecordEpisodeStatistics``: "r", "l") and what roto's
+results, logs and tables call them; task metrics keep their own names."""
+
+
+def readable(name: str) -> str:
+    """The name results use for ``info["episode"]`` key ``name`` ("r" -> "return")."""
+    return EPISODE_NAMES.get(name, name)
+
 
 def first_episodes(
     env: Any,
@@ -23,13 +32,13 @@ def first_episodes(
     ``on_done(mask (B,))`` is called whenever envs finish (e.g. to reset a policy's own state).
 
     Returns:
-        {"r", "l", and each task metric: (B, episodes_per_env) float64}, in env order.
+        {"return", "length", and each task metric: (B, episodes_per_env) float64}, in env order.
     """
     if episodes_per_env < 1:
         raise ValueError(f"episodes per env must be >= 1, got {episodes_per_env}")
     n = env.num_envs
     names = ("r", "l", *env.task.metric_names)
-    result = {name: torch.full((n, episodes_per_env), float("nan"), dtype=torch.float64) for name in names}
+    result = {readable(name): torch.full((n, episodes_per_env), float("nan"), dtype=torch.float64) for name in names}
     count = torch.zeros(n, dtype=torch.int64)
     with tqdm(total=n * episodes_per_env, disable=not progress, desc="episodes") as bar:
         while bool((count < episodes_per_env).any()):
@@ -41,7 +50,7 @@ def first_episodes(
                 on_done(done)
             ids = torch.nonzero(done.cpu() & (count < episodes_per_env)).flatten()  # the tally lives on the host
             for name in names:
-                result[name][ids, count[ids]] = info["episode"][name].cpu()[ids].to(torch.float64)
+                result[readable(name)][ids, count[ids]] = info["episode"][name].cpu()[ids].to(torch.float64)
             count[ids] += 1
             bar.update(len(ids))
     return result

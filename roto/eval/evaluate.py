@@ -41,8 +41,7 @@ def evaluate(
             result = first_episodes(env, model.act_deterministic, obs)
         env.close()
         for name, values in result.items():
-            key = {"r": "return", "l": "length"}.get(name, name)
-            per_episode.setdefault(key, []).extend(values[:, 0].tolist())
+            per_episode.setdefault(name, []).extend(values[:, 0].tolist())
     summary: dict[str, object] = {"episodes": episodes}
     for key, values in per_episode.items():
         t = torch.tensor(values, dtype=torch.float64)

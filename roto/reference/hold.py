@@ -25,10 +25,10 @@ def run_hold(
         "task": env.task.name,
         "robot": env.robot.name,
         "episodes": num_envs,
-        "mean_return": float(result["r"].mean()),
-        "std_return": float(result["r"].std()),
-        "mean_length": float(result["l"].mean()),
-        "full_length_share": float((result["l"] == env.config.episode_steps).to(torch.float64).mean()),
+        "mean_return": float(result["return"].mean()),
+        "std_return": float(result["return"].std()),
+        "mean_length": float(result["length"].mean()),
+        "full_length_share": float((result["length"] == env.config.episode_steps).to(torch.float64).mean()),
     }
     stats.update({f"mean_{name}": float(result[name].mean()) for name in env.task.metric_names})
     return stats

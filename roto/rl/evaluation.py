@@ -21,7 +21,6 @@ from roto.rl.networks import ActorCritic
 from roto.rl.torch_threads import single_torch_thread
 
 EVALUATIONS_NAME = "evaluations.jsonl"
-EPISODE_KEYS = {"r": "return", "l": "length"}
 
 
 def summarize(per_episode: dict[str, list[float]]) -> dict[str, float]:
@@ -61,7 +60,7 @@ class PolicyEvaluator:
         with single_torch_thread(self.env.device):
             result = first_episodes(self.env, model.act_deterministic, obs)
         model.train(was_training)
-        per_episode = {EPISODE_KEYS.get(name, name): values[:, 0].tolist() for name, values in result.items()}
+        per_episode = {name: values[:, 0].tolist() for name, values in result.items()}
         record = {**fields, "eval_s": time.perf_counter() - start, **summarize(per_episode)}
         record["per_episode"] = per_episode
         with self.path.open("a") as f:

@@ -17,6 +17,7 @@ import torch
 from tqdm import tqdm
 
 from roto.envs.config import EnvConfig
+from roto.envs.episodes import readable
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import build_learner, build_model, extra_groups, stacked_sizes
 from roto.rl.checkpoints import load_checkpoint, save_checkpoint
@@ -58,7 +59,7 @@ class EpisodeStats:
         self.count.zero_()
         if count == 0:
             return {}
-        tags = [{"r": "return", "l": "length"}.get(n, n) for n in self.names]
+        tags = [readable(n) for n in self.names]
         return {f"train/episode_{tag}": mean for tag, mean in zip(tags, means, strict=True)}
 
 

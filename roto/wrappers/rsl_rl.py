@@ -34,9 +34,10 @@ except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError("roto.wrappers.rsl_rl needs RSL-RL: pip install -e '.[rsl_rl]'") from error
 
 from roto.envs.config import EnvConfig
+from roto.envs.episodes import EPISODE_NAMES
 from roto.envs.roto_env import RotoEnv
 
-_LOG_NAMES = {"r": "return", "l": "length"}
+_LOG_NAMES = EPISODE_NAMES
 """roto's short episode-info keys, spelled out for RSL-RL's log (other keys keep their names)."""
 
 

@@ -43,10 +43,11 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError("roto.wrappers.skrl needs skrl: pip install -e '.[skrl]'") from error
 
+from roto.envs.episodes import EPISODE_NAMES
 from roto.envs.observations import OBS_MODES
 from roto.envs.roto_env import RotoEnv
 
-_LOG_NAMES = {"r": "return", "l": "length", "time_out": "time-out share"}
+_LOG_NAMES = {**EPISODE_NAMES, "time_out": "time-out share"}
 """roto's short episode-info keys, spelled out for skrl's log (other keys keep their names)."""
 
 
