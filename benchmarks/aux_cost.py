@@ -18,8 +18,8 @@ import tempfile
 import torch
 
 from roto.envs.config import EnvConfig
-from roto.eval.plots import read_scalars
 from roto.rl.config import load_agent_config
+from roto.rl.run_dir import read_scalars
 from roto.rl.runner import Trainer, TrainSettings
 
 FD = "weight: 0.0021, lr: 1.5e-5, seq_length: 8"

@@ -16,7 +16,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from roto.eval.plots import read_scalars
+from roto.rl.run_dir import read_scalars
 
 WINDOW = 10  # evaluation rounds in the running mean
 THRESHOLDS = (5, 10, 18, 25)  # running-mean levels whose first crossing the summary reports

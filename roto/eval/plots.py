@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import pathlib
 from collections.abc import Mapping, Sequence
 
@@ -10,17 +9,6 @@ import numpy as np
 
 from roto.result_files import replacing
 from roto.rl.evaluation import read_evaluations
-
-
-def read_scalars(run_dir: str | pathlib.Path) -> dict[str, tuple[list[int], list[float]]]:
-    """{tag: (env_steps, values)} from ``<run_dir>/scalars.csv``."""
-    series: dict[str, tuple[list[int], list[float]]] = {}
-    with (pathlib.Path(run_dir) / "scalars.csv").open() as f:
-        for row in csv.DictReader(f):
-            steps, values = series.setdefault(row["tag"], ([], []))
-            steps.append(int(row["env_steps"]))
-            values.append(float(row["value"]))
-    return series
 
 
 def curve_metrics(records: Sequence[Mapping]) -> list[str]:

@@ -25,7 +25,7 @@ from roto.olympiad.plan import Cell, Plan
 from roto.result_files import write_text_atomic
 from roto.rl.checkpoints import load_checkpoint
 from roto.rl.evaluation import read_evaluations
-from roto.rl.run_dir import CHECKPOINT_DIR
+from roto.rl.run_dir import RunDir
 from roto.rl.run_spec import RunSpec, build_run_spec
 from roto.rl.runner import Trainer
 from roto.tasks import get_task
@@ -68,7 +68,7 @@ def run_cell(
         trainer.evaluator.env.close()
     final = copy.deepcopy(trainer.model).cpu().eval()
     best = copy.deepcopy(final)
-    best.load_state_dict(load_checkpoint(run_dir / CHECKPOINT_DIR / "best.pt")["model"])
+    best.load_state_dict(load_checkpoint(RunDir(run_dir).checkpoint("best"))["model"])
     records = read_evaluations(run_dir)
     entry = plan.variants[cell.variant].for_task(cell.task)
     summary = {

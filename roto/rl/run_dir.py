@@ -3,19 +3,24 @@
 ``<run_dir>/config.yaml`` (``roto.rl.settings``), ``scalars.csv``, ``evaluations.jsonl``,
 ``tensorboard/`` and ``checkpoints/``: ``latest.pt`` (everything a resume needs), ``best.pt`` and
 the numbered copies ``agent_<update>.pt`` (the policy only, ``POLICY_KEYS``). ``load_policy``
-reads any of them without building an env.
+reads any of them without building an env; ``RunDir`` gathers the readers of one run.
 """
 
 from __future__ import annotations
 
+import csv
 import pathlib
+from dataclasses import dataclass
+from typing import Any
 
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import build_model, extra_groups, stacked_sizes
 from roto.rl.checkpoints import load_checkpoint
 from roto.rl.config import AgentConfig, from_dict
+from roto.rl.evaluation import read_evaluations
+from roto.rl.logger import CSV_NAME
 from roto.rl.networks import ActorCritic
-from roto.rl.settings import TrainSettings
+from roto.rl.settings import TrainSettings, read_run_config
 
 CHECKPOINT_DIR = "checkpoints"
 POLICY_KEYS = ("model", "train", "agent", "obs_sizes", "num_actions", "update", "env_steps", "best_eval_return",
@@ -60,3 +65,45 @@ def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSetti
     model.load_state_dict(state["model"])
     model.eval()
     return model, settings, agent
+
+
+def read_scalars(run_dir: str | pathlib.Path) -> dict[str, tuple[list[int], list[float]]]:
+    """{tag: (env_steps, values)} from ``<run_dir>/scalars.csv``."""
+    series: dict[str, tuple[list[int], list[float]]] = {}
+    with (pathlib.Path(run_dir) / CSV_NAME).open() as f:
+        for row in csv.DictReader(f):
+            steps, values = series.setdefault(row["tag"], ([], []))
+            steps.append(int(row["env_steps"]))
+            values.append(float(row["value"]))
+    return series
+
+
+@dataclass(frozen=True)
+class RunDir:
+    """A run directory and its readers: everything ``roto train`` writes, read back."""
+
+    path: pathlib.Path
+
+    def config(self) -> tuple[TrainSettings, AgentConfig]:
+        """The run's settings and agent config (``config.yaml``)."""
+        return read_run_config(self.path)
+
+    def evaluations(self) -> list[dict[str, Any]]:
+        """Every training-time evaluation record (``evaluations.jsonl``), oldest first."""
+        return read_evaluations(self.path)
+
+    def scalars(self) -> dict[str, tuple[list[int], list[float]]]:
+        """{tag: (env_steps, values)} of every logged scalar (``scalars.csv``)."""
+        return read_scalars(self.path)
+
+    def checkpoint(self, name: str = "latest") -> pathlib.Path:
+        """The path of checkpoint ``name`` (``latest``, ``best``, ``agent_<update>``)."""
+        return checkpoint_path(self.path, name)
+
+    def has_checkpoint(self, name: str = "latest") -> bool:
+        """Whether checkpoint ``name`` exists (``latest``: whether the run can be continued)."""
+        return self.checkpoint(name).is_file()
+
+    def policy(self, name: str = "best") -> tuple[ActorCritic, TrainSettings, AgentConfig]:
+        """The policy of checkpoint ``name`` with the run's settings (``load_policy``: no env built)."""
+        return load_policy(self.checkpoint(name))

@@ -24,7 +24,7 @@ from roto.rl.checkpoints import load_checkpoint, save_checkpoint
 from roto.rl.config import AgentConfig, to_dict
 from roto.rl.evaluation import PolicyEvaluator
 from roto.rl.logger import ScalarLogger
-from roto.rl.run_dir import CHECKPOINT_DIR, POLICY_KEYS, first_missing, numbered_checkpoints
+from roto.rl.run_dir import CHECKPOINT_DIR, POLICY_KEYS, RunDir, first_missing, numbered_checkpoints
 from roto.rl.run_lock import hold_run_lock
 from roto.rl.run_spec import RunSpec
 from roto.rl.settings import TrainSettings, read_run_config, run_config, write_run_config
@@ -309,10 +309,9 @@ class Trainer:
             FileNotFoundError (via ``resume``) when there is neither a checkpoint nor a spec.
         """
         run_dir = pathlib.Path(run_dir)
-        has_checkpoint = (run_dir / CHECKPOINT_DIR / "latest.pt").is_file()
-        if spec is None or has_checkpoint:
+        if spec is None or RunDir(run_dir).has_checkpoint():
             if spec is not None:
-                settings, agent = read_run_config(run_dir)
+                settings, agent = RunDir(run_dir).config()
                 stored = RunSpec(env=settings.env, agent=agent, steps=settings.total_steps)
                 differ = spec.differences(stored)
                 if differ:

@@ -232,3 +232,20 @@ def test_resuming_from_a_policy_only_checkpoint_says_so(tmp_path):
     (folder / "best.pt").replace(folder / "latest.pt")
     with pytest.raises(ValueError, match="holds a policy only"):
         Trainer.resume(tmp_path / "run", tensorboard=False)
+
+
+def test_a_run_directory_reads_back_what_training_wrote(tmp_path):
+    from roto.rl.run_dir import RunDir
+
+    trainer = tiny_trainer(tmp_path, "run", 2, extra=["run.eval_every=1"])
+    trainer.train(progress=False)
+    run = RunDir(tmp_path / "run")
+    settings, agent = run.config()
+    assert settings == trainer.settings and agent == trainer.agent
+    assert [r["update"] for r in run.evaluations()] == [1, 2]
+    steps, values = run.scalars()["eval/return_mean"]
+    assert steps == [16, 32] and values == [r["return_mean"] for r in run.evaluations()]
+    assert run.has_checkpoint() and run.has_checkpoint("best") and not run.has_checkpoint("agent_7")
+    model, loaded_settings, _ = run.policy("latest")
+    assert loaded_settings == settings
+    assert all(torch.equal(v, trainer.model.state_dict()[k]) for k, v in model.state_dict().items())
