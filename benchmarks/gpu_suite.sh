@@ -59,9 +59,9 @@ if [ "$train_s" -gt 0 ]; then
   if [ "$status" -ne 0 ] && [ "$status" -ne 124 ]; then failed+=(train); fi
   for which in best latest; do
     step "policy_$which" /dev/null python3 -c "import sys, torch
+from roto.rl.run_dir import POLICY_KEYS  # what a policy-only checkpoint holds (best.pt already is one)
 state = torch.load(sys.argv[1], weights_only=True, map_location='cpu')
-keep = ('model', 'train', 'agent', 'update', 'env_steps', 'best_eval_return', 'last_eval')
-torch.save({k: state[k] for k in keep}, sys.argv[2])" "$run/checkpoints/$which.pt" "$run/policy_$which.pt"
+torch.save({k: state[k] for k in POLICY_KEYS}, sys.argv[2])" "$run/checkpoints/$which.pt" "$run/policy_$which.pt"
   done
   rm -f "$run"/checkpoints/*.pt  # full checkpoints hold the envs' state (hundreds of MB at 8192 envs)
 fi
