@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import gymnasium as gym
+import mujoco
 import numpy as np
 import torch
 
@@ -31,7 +32,7 @@ from roto.envs.start_draw import draw_candidates, draw_starts
 from roto.envs.start_pool import StartPool, check_balls_start_clear
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
-from roto.sim.backend import make_backend
+from roto.sim.backend import Backend, make_backend
 from roto.sim.host_sync import deliberate_host_sync, resolve_device
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
@@ -49,6 +50,17 @@ class _Episode:
     ret: torch.Tensor  # float64 return so far
 
 
+def backend_for(config: EnvConfig, model: mujoco.MjModel) -> Backend:
+    """The physics backend ``config`` names for ``model``; Warp's fixed per-world contact and
+    constraint buffers are roto's measured figures for the pair unless the config gives them."""
+    capacity = {}
+    if config.backend == "warp":
+        nconmax, njmax = warp_capacity(config.robot, config.task)
+        capacity = {"nconmax": config.nconmax or nconmax, "njmax": config.njmax or njmax}
+    return make_backend(config.backend, model, config.num_envs, substeps=config.substeps, threads=config.threads,
+                        device=config.device, **capacity)  # fmt: skip
+
+
 class RotoEnv:
     """B parallel worlds of one roto task on one robot (see ``roto.make``)."""
 
@@ -64,19 +76,7 @@ class RotoEnv:
         self.groups = tuple(group for group in OBS_GROUPS if group in wanted)
         self.balls = self.task.balls(self.robot)
         self.model, self.layout = build_scene(self.robot, self.balls, config.touch)
-        capacity = {}
-        if config.backend == "warp":  # fixed per-world buffers: roto's measured figures unless given
-            nconmax, njmax = warp_capacity(config.robot, config.task)
-            capacity = {"nconmax": config.nconmax or nconmax, "njmax": config.njmax or njmax}
-        self.backend = make_backend(
-            config.backend,
-            self.model,
-            config.num_envs,
-            substeps=config.substeps,
-            threads=config.threads,
-            device=config.device,
-            **capacity,
-        )
+        self.backend = backend_for(config, self.model)
         self._generator = torch.Generator(device=self.device)
         self._generator.manual_seed(config.seed)
         self._idx = SceneIndices.from_layout(self.layout, self.robot, self.model, self.device, config.touch)
