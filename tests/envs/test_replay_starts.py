@@ -136,3 +136,18 @@ def test_both_backends_draw_the_same_replayed_starts():
     assert torch.equal(a["frame/tactile"], b["frame/tactile"])
     cpu.close()
     warp.close()
+
+
+@pytest.mark.parametrize("robot", ["shadow_lite", "allegro", "orca"])
+def test_every_hands_bank_replays_in_its_own_scene_with_the_task_state_it_was_recorded_in(robot):
+    bank_file = BANK.replace("shadow_preswap", f"{robot}_preswap")
+    env = roto.make("baoding", robot=robot, num_envs=8, seed=0, replay_starts=bank_file, replay_share=1.0)
+    obs, _ = env.reset()
+    saved, bank = np.load(bank_file), env.replay_bank
+    physics = torch.from_numpy(env.backend.physics_state())
+    for world in range(env.num_envs):  # each world is one recorded state, with its own latches
+        k = int(torch.nonzero((bank.qpos == physics[world, 1 : 1 + env.model.nq]).all(dim=1))[0])
+        assert bool(env.task_state.swapped[world]) == bool(saved["swapped"][k])
+        assert env.task_state.latched[world].tolist() == saved["latched"][k].tolist()
+    assert all(torch.isfinite(value).all() for value in obs.values())
+    env.close()
