@@ -321,7 +321,9 @@ class Trainer:
                     )
                 steps = spec.steps
             return cls.resume(run_dir, steps, tensorboard, env_factory, wandb_project)
-        return cls(spec.settings, spec.agent, run_dir, tensorboard, env_factory, wandb_project)
+        trainer = cls(spec.settings, spec.agent, run_dir, tensorboard, env_factory, wandb_project)
+        trainer.evaluator.drop_after(0)  # a run that died before its first checkpoint starts over, records too
+        return trainer
 
     @classmethod
     def resume(

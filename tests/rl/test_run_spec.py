@@ -44,3 +44,19 @@ def test_open_creates_then_continues_a_run_and_refuses_other_settings(tmp_path):
         Trainer.open(run, other, tensorboard=False, env_factory=ToyEnv)
     with pytest.raises(FileNotFoundError):
         Trainer.open(tmp_path / "nothing_here", tensorboard=False, env_factory=ToyEnv)
+
+
+def test_a_run_that_died_before_its_first_checkpoint_starts_over_without_its_old_records(tmp_path):
+    from roto.rl.evaluation import read_evaluations
+
+    spec = build_run_spec("bounce", obs="proprio", overrides=[*TINY, "run.eval_every=1"], steps=32, num_envs=4)
+    run = tmp_path / "run"
+    Trainer.open(run, spec, tensorboard=False, env_factory=ToyEnv).train(progress=False)
+    first = read_evaluations(run)
+    for checkpoint in (run / "checkpoints").glob("*.pt"):
+        checkpoint.unlink()  # as if it had died after its evaluations, before any checkpoint
+    again = Trainer.open(run, spec, tensorboard=False, env_factory=ToyEnv)
+    assert again.update == 0 and read_evaluations(run) == []
+    again.train(progress=False)
+    assert [r["update"] for r in read_evaluations(run)] == [1, 2]
+    assert [r["return_mean"] for r in read_evaluations(run)] == [r["return_mean"] for r in first]  # same seed
