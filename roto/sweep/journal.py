@@ -15,7 +15,7 @@ import pathlib
 import sys
 from typing import Any
 
-from optuna.storages.journal import JournalFileBackend
+from optuna.storages.journal import JournalFileBackend, JournalFileSymlinkLock
 
 TAIL_CHUNK = 1 << 16
 
@@ -41,24 +41,30 @@ def drop_torn_tail(path: pathlib.Path) -> int:
 
 
 class JournalFile(JournalFileBackend):
-    """``JournalFileBackend`` whose appends drop a torn last line first (see the module docstring)."""
+    """``JournalFileBackend`` whose appends drop a torn last line first (see the module docstring),
+    under Optuna's symlink lock (which works on network filesystems), the one its reads share."""
+
+    def __init__(self, file_path: str) -> None:
+        self.path = pathlib.Path(file_path)
+        self.lock = JournalFileSymlinkLock(file_path)
+        super().__init__(file_path, lock_obj=self.lock)
 
     def append_logs(self, logs: list[dict[str, Any]]) -> None:
         """Append ``logs`` as JSON lines, flushed to disk, after dropping any torn last line."""
         text = "".join(json.dumps(log, separators=(",", ":")) + "\n" for log in logs)
-        self._lock.acquire()
+        self.lock.acquire()
         try:
-            dropped = drop_torn_tail(pathlib.Path(self._file_path))
+            dropped = drop_torn_tail(self.path)
             if dropped:
                 print(
-                    f"roto: warning: {self._file_path}: dropped a torn last line ({dropped} bytes) that a "
+                    f"roto: warning: {self.path}: dropped a torn last line ({dropped} bytes) that a "
                     "process left when it died while writing; the operation it was writing is lost",
                     file=sys.stderr,
                     flush=True,
                 )
-            with open(self._file_path, "ab") as f:
+            with open(self.path, "ab") as f:
                 f.write(text.encode("utf-8"))
                 f.flush()
                 os.fsync(f.fileno())
         finally:
-            self._lock.release()
+            self.lock.release()
