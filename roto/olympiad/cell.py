@@ -26,6 +26,7 @@ from roto.result_files import write_text_atomic
 from roto.rl.checkpoints import load_checkpoint
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import RunDir
+from roto.rl.run_lock import wait_until_free
 from roto.rl.run_spec import RunSpec, build_run_spec
 from roto.rl.runner import Trainer
 from roto.tasks import get_task
@@ -60,6 +61,7 @@ def run_cell(
     env_factory: Callable[[EnvConfig], Any] = RotoEnv,
 ) -> dict[str, Any]:
     """Train (or continue) the cell, evaluate it, write and return its summary."""
+    wait_until_free(run_dir)  # a retry of a cell whose first worker, declared dead, is still training it
     trainer = Trainer.open(run_dir, cell_spec(plan, cell), env_factory=env_factory)
     try:
         trainer.train(progress=False)

@@ -43,3 +43,23 @@ def hold_run_lock(run_dir: pathlib.Path) -> IO[str] | None:
     handle.write(f"process {os.getpid()}\n")
     handle.flush()
     return handle
+
+
+def wait_until_free(run_dir: pathlib.Path) -> None:
+    """Return once no process holds ``run_dir``'s lock, saying once that it waits.
+
+    For sweep and Olympiad workers about to continue a run whose first worker was declared dead
+    (no heartbeat for a while) but may still be alive and training it: that worker releases the run
+    when it ends, and the retry then continues from its latest checkpoint instead of failing.
+    """
+    path = run_dir / LOCK_NAME
+    if fcntl is None or not path.is_file():
+        return
+    with path.open("a+") as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            holder = handle.read().strip() or "another process"
+            print(f"roto: run {str(run_dir)!r} is still used by {holder}; waiting until it lets go", flush=True)
+            fcntl.flock(handle, fcntl.LOCK_EX)  # closing the file below unlocks it for the trainer

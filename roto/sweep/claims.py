@@ -2,8 +2,9 @@
 
 Shared by ``roto sweep`` (a trial is a set of parameters) and ``roto olympiad`` (a trial is a
 cell of the plan). A ``optuna.TrialPruned`` from the work ends the trial pruned with its message
-as the reason; any other exception, Ctrl-C included, fails it and enqueues a retry, then goes on
-up. ``launch_workers`` starts worker processes of a ``roto`` subcommand here.
+as the reason; a trial another worker has meanwhile declared dead (its report refused) is left to
+its retry, which continues the run; any other exception, Ctrl-C included, fails it and enqueues a
+retry, then goes on up. ``launch_workers`` starts worker processes of a ``roto`` subcommand here.
 """
 
 from __future__ import annotations
@@ -41,6 +42,9 @@ def run_claimed(
             value = work(storage.get_trial(trial_id).system_attrs)
     except optuna.TrialPruned as error:
         state, reason = TrialState.PRUNED, str(error)
+    except UpdateFinishedTrialError:  # declared dead by another worker (a long silence): its retry takes over
+        print(f"trial {trial.number}: declared dead by another worker; its retry continues the run", flush=True)
+        return False
     except BaseException as error:  # Ctrl-C or a crash: fail it and enqueue a retry that resumes its run
         fail_and_retry(study, storage, trial, f"{type(error).__name__}: {error}")
         raise

@@ -22,6 +22,7 @@ import torch
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
 from roto.rl.evaluation import read_evaluations
+from roto.rl.run_lock import wait_until_free
 from roto.rl.run_spec import RunSpec, build_run_spec
 from roto.rl.runner import Trainer
 from roto.sweep.space import SearchSpace, as_overrides
@@ -90,6 +91,7 @@ def run_trial(
     trial.set_user_attr("seed", seed)
     trial.set_user_attr("run_dir", str(run_dir))
     monitor = TrialMonitor(trial)
+    wait_until_free(run_dir)  # a retry of a trial whose first worker, declared dead, is still training it
     trainer = Trainer.open(run_dir, trial_spec(settings, params, seed), tensorboard=True, env_factory=env_factory)
     for record in read_evaluations(run_dir):  # a retry: the earlier try's reports, on this trial
         monitor.best = max(monitor.best, record["return_mean"])

@@ -249,3 +249,20 @@ def test_a_run_directory_reads_back_what_training_wrote(tmp_path):
     model, loaded_settings, _ = run.policy("latest")
     assert loaded_settings == settings
     assert all(torch.equal(v, trainer.model.state_dict()[k]) for k, v in model.state_dict().items())
+
+
+def test_a_worker_retrying_a_run_still_in_use_waits_until_it_is_free(tmp_path, capsys):
+    import threading
+    import time
+
+    from roto.rl.run_lock import wait_until_free
+
+    holder = tiny_trainer(tmp_path, "run", 1)  # holds the run's lock, as a worker declared dead but alive would
+    waiter = threading.Thread(target=wait_until_free, args=(tmp_path / "run",))
+    waiter.start()
+    time.sleep(0.5)
+    assert waiter.is_alive() and "is still used by process" in capsys.readouterr().out
+    holder.train(progress=False)  # its training ends and lets the run go
+    waiter.join(timeout=10)
+    assert not waiter.is_alive()
+    Trainer.resume(tmp_path / "run", total_steps=32, tensorboard=False).train(progress=False)  # free again

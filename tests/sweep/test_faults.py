@@ -144,7 +144,7 @@ def test_reclaim_now_retries_running_trials_without_waiting(tmp_path, capsys):
 
 def test_a_database_restart_during_a_two_worker_sweep_costs_no_worker_and_no_trial(tmp_path, postgres_binaries):
     with running_server(postgres_binaries) as server:
-        settings = toy_settings(tmp_path, trials=6, updates=30, study="toy_restart", storage=server.url, heartbeat=1.0)
+        settings = toy_settings(tmp_path, trials=6, updates=30, study="toy_restart", storage=server.url, heartbeat=2.0)
         open_study(settings)
         context = multiprocessing.get_context("spawn")
         workers = [context.Process(target=toy_worker, args=(settings,)) for _ in range(2)]
@@ -170,3 +170,28 @@ def test_a_database_gone_for_good_is_a_one_line_runtime_failure_of_the_cli():
     from roto.cli_errors import error_exit
 
     assert error_exit(DatabaseUnreachable("the database 'db' was unreachable for 60 s")) == (1, "failed")
+
+
+def test_a_live_trial_declared_dead_is_left_to_its_retry_which_continues_its_run(tmp_path, capsys):
+    from roto.sweep.storage import reclaim_now
+
+    torch.set_num_threads(1)
+    settings = toy_settings(tmp_path, trials=1, updates=8, heartbeat=30.0)
+    study, storage = open_study(settings)
+
+    class DeclaredDeadMidTrial(ToyEnv):
+        steps = 0
+
+        def step(self, action):
+            DeclaredDeadMidTrial.steps += 1
+            if DeclaredDeadMidTrial.steps == 40:  # as another worker would after a long silence
+                reclaim_now(study, storage)
+            return super().step(action)
+
+    assert run_worker(settings, env_factory=DeclaredDeadMidTrial) == 1  # the retry's; no crash on the refused report
+    assert "trial 0: declared dead by another worker; its retry continues the run" in capsys.readouterr().out
+    study = optuna.load_study(study_name=settings.study, storage=open_storage(settings.study_dir))
+    first, retry = study.trials
+    assert first.state == TrialState.FAIL and retry.state in FINISHED and retry.system_attrs["failed_trial"] == 0
+    steps = [r["env_steps"] for r in read_evaluations(run_dir_of(settings, 0))]
+    assert steps == sorted(set(steps)) and steps[-1] == settings.steps  # one run, continued to its end
