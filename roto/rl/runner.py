@@ -24,7 +24,7 @@ from roto.rl.checkpoints import load_checkpoint, save_checkpoint
 from roto.rl.config import AgentConfig, to_dict
 from roto.rl.evaluation import PolicyEvaluator
 from roto.rl.logger import ScalarLogger
-from roto.rl.run_dir import CHECKPOINT_DIR, POLICY_KEYS, RunDir, first_missing, numbered_checkpoints
+from roto.rl.run_dir import CHECKPOINT_DIR, RunDir, first_missing, numbered_checkpoints
 from roto.rl.run_lock import hold_run_lock
 from roto.rl.run_spec import RunSpec
 from roto.rl.settings import TrainSettings, read_run_config, run_config, write_run_config
@@ -247,27 +247,28 @@ class Trainer:
     def state_dict(self) -> dict[str, Any]:
         """Everything needed to continue bit-identically (plain data: see ``roto.rl.checkpoints``)."""
         return {
-            "model": self.model.state_dict(),
+            **self.policy_state(),
             "ppo": self.alg.state_dict(),
             "torch_rng": torch.get_rng_state(),
             "env": self.env.state_dict(),
             "obs": self.obs,
-            "update": self.update,
-            "env_steps": self.env_steps,
-            "best_eval_return": self.best_eval_return,
             "train_seconds": self.train_seconds,
-            "last_eval": self.last_eval,
+        }
+
+    def policy_state(self) -> dict[str, Any]:
+        """The policy and what loading it needs (``POLICY_KEYS``): no optimiser, env or RNG state
+        (a third of ``state_dict``'s size, and nothing copied from the envs)."""
+        return {
+            "model": self.model.state_dict(),
             "train": self.settings.to_dict(),
             "agent": to_dict(self.agent),
             "obs_sizes": stacked_sizes(self.env),
             "num_actions": self.env.num_actions,
+            "update": self.update,
+            "env_steps": self.env_steps,
+            "best_eval_return": self.best_eval_return,
+            "last_eval": self.last_eval,
         }
-
-    def policy_state(self) -> dict[str, Any]:
-        """The policy and what loading it needs (``POLICY_KEYS``): no optimiser or env state, a
-        third of ``state_dict``'s size."""
-        state = self.state_dict()
-        return {key: state[key] for key in POLICY_KEYS}
 
     def save(self, path: pathlib.Path, policy_only: bool = False) -> None:
         """Write a checkpoint atomically: everything to resume from, or with ``policy_only`` the
