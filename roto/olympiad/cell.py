@@ -11,7 +11,6 @@ cells trained on other machines or in other sittings combine.
 from __future__ import annotations
 
 import copy
-import dataclasses
 import json
 import pathlib
 import subprocess
@@ -49,7 +48,7 @@ def cell_spec(plan: Plan, cell: Cell) -> RunSpec:
     agent_cfg, overrides = plan.variants[cell.variant].agent_for(cell.task, cell.robot)
     spec = build_run_spec(cell.task, cell.robot, cell.obs, agent_cfg, overrides, plan.steps, num_envs=plan.num_envs,
                           threads=plan.threads, backend=plan.backend, device=plan.device)  # fmt: skip
-    return dataclasses.replace(spec, env=dataclasses.replace(spec.env, seed=cell.seed))
+    return spec.with_seed(cell.seed)
 
 
 def run_cell(

@@ -54,8 +54,6 @@ def variant_agents(summaries: list[dict], plan: str = "") -> Agents:
     agents: Agents = {}
     for s in summaries:
         agents.setdefault((s["task"], s["variant"]), s.get("agent") or {"label": "", "roto_agent": None})
-        if s.get("task_version") != get_task(s["task"]).version:  # trained on another (or an unrecorded) version
-            agents[(s["task"], "")] = {"stale": True}
     with contextlib.suppress(ValueError, FileNotFoundError):
         for name, variant in load_plan(plan).variants.items() if plan else ():
             for entry in variant.per_task:
@@ -97,7 +95,13 @@ def improvements(scores: dict[Key, np.ndarray]) -> list[tuple[str, str, str, str
     return out
 
 
-def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None) -> str:
+def current_tasks(summaries: list[dict]) -> set[str]:
+    """Tasks whose every summary records the task's current version (``Task.version``)."""
+    tasks = {s["task"] for s in summaries}
+    return {t for t in tasks if all(s.get("task_version") == get_task(t).version for s in summaries if s["task"] == t)}
+
+
+def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None, current: set[str] | None = None) -> str:
     """Hands as rows, (task, obs, variant: its agent) as columns; each task's reference (``Task.reference``)
     and roto v1's figure beside the variants that declare themselves roto's agent."""
     agents = agents or {}
@@ -106,7 +110,7 @@ def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None) 
     order = list(get_task("bounce").reference)
     robots = sorted({robot for _, robot, _, _ in scores}, key=lambda r: order.index(r) if r in order else len(order))
 
-    current = [t for t in tasks if (t, "") not in agents]  # every summary of the task's current version
+    current = [t for t in tasks if t in (current or set())]  # tasks whose summaries are all of today's version
 
     def header(task: str, obs: str, variant: str) -> str:
         label = agents.get((task, variant), {}).get("label")
@@ -178,7 +182,7 @@ def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str
         scores = scores_by_cell(summaries, policy)
         write_csv(scores, out / f"results_{policy}.csv", policy)
         heading = f"## {policy} policy: task metric per 10 s episode, mean ± std over seeds"
-        md += [heading, "", markdown_table(scores, agents), ""]
+        md += [heading, "", markdown_table(scores, agents, current_tasks(summaries)), ""]
     pairs = improvements(scores_by_cell(summaries, "final"))
     if pairs:
         md += ["## Probability of improvement (final policies)", ""]

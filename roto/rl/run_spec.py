@@ -36,6 +36,11 @@ class RunSpec:
         """The envs and budget as ``TrainSettings`` (what ``config.yaml``'s ``train`` section holds)."""
         return TrainSettings(env=self.env, total_steps=self.steps)
 
+    def with_seed(self, seed: int) -> RunSpec:
+        """This run with env seed ``seed`` (a sweep trial's or an Olympiad cell's own, which wins
+        over any ``env.seed`` override)."""
+        return dataclasses.replace(self, env=dataclasses.replace(self.env, seed=seed))
+
     def differences(self, other: RunSpec) -> dict[str, tuple[Any, Any]]:
         """{dotted key: (this value, other's value)} where the two specs train differently (the
         budget aside: a run may be extended)."""

@@ -10,7 +10,6 @@ reason stored on the trial.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import pathlib
 from collections.abc import Callable
@@ -69,7 +68,7 @@ def trial_spec(settings: SweepSettings, params: dict[str, Any], seed: int) -> Ru
         settings.task, settings.robot, settings.obs, settings.agent_cfg, [*settings.overrides, *as_overrides(params)],
         settings.steps, num_envs=settings.num_envs, threads=settings.threads,
     )  # fmt: skip
-    return dataclasses.replace(spec, env=dataclasses.replace(spec.env, seed=seed))
+    return spec.with_seed(seed)
 
 
 def run_trial(
