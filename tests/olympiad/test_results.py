@@ -57,3 +57,17 @@ def test_results_match_hand_computed_statistics(tmp_path, capsys):
 def test_results_of_a_folder_without_summaries_is_a_clear_error(tmp_path, capsys):
     assert main(["results", str(tmp_path), "--out", str(tmp_path / "out")]) == 2
     assert "no cell summaries" in capsys.readouterr().err
+
+
+def test_summaries_of_an_older_or_unrecorded_task_version_get_no_reference_column(tmp_path):
+    from roto.olympiad.results import write_results
+
+    write_summaries(tmp_path / "summaries")
+    old = tmp_path / "summaries" / "baoding-allegro-blind-ppo-seed0.json"
+    summary = json.loads(old.read_text())
+    del summary["task_version"]
+    old.write_text(json.dumps(summary))
+    write_results(tmp_path / "summaries", tmp_path / "out")
+    md = (tmp_path / "out" / "results.md").read_text()
+    assert "baoding (older or unrecorded version) / blind / ppo" in md and "bounce (v0) / blind / ppo" in md
+    assert "reference controller" not in md and "scripted Bounce (bounces, v0)" in md
