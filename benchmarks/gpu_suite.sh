@@ -14,6 +14,12 @@
 #                     with policy_best.pt / policy_latest.pt (weights and settings only, for `roto eval`
 #                     and `roto play` elsewhere); TRAIN_OVERRIDES go to `roto train` (ppo.cuda_graph=true)
 #   suite.log         one line per step: exit status and seconds
+# A short lease runs a subset, chosen by environment variables (defaults: everything):
+#   PAIRS="bounce:shadow"        the (task:robot) pairs benched (default all eight)
+#   SCALING="8192"               the env counts of the scaling line (default 1024 ... 32768; "" skips it)
+#   PYTEST_FILES="tests/rl/..."  the GPU test files (default the three below)
+#   UPDATE_AGENTS="bounce bounce_cpu_quickstart"  agent configs whose update is timed (default bounce)
+#   DEADLINE=<epoch seconds>     training stops 60 s before it (room for the policies), whatever TRAIN_SECONDS says
 # Exits non-zero, naming the failed steps and the tail of their error output, if any step failed.
 set -uo pipefail
 out=${1:?usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS] [TRAIN_OVERRIDES...]}
@@ -35,19 +41,26 @@ step() {  # step NAME STDOUT_FILE COMMAND...: run it, log status and time, remem
 }
 
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv > "$out/gpu.txt" 2>&1 || failed+=(nvidia-smi)
-step pytest_gpu "$out/pytest_gpu.txt" python3 -m pytest -q -m gpu -p no:cacheprovider \
-  tests/envs/test_sync_free_step.py tests/rl/test_training_gpu.py tests/rl/test_graphed_step.py
-step update_cost "$out/update_cost.jsonl" python3 benchmarks/update_cost.py --device cuda --num_envs "$num_envs"
-for task in bounce baoding; do
-  for robot in shadow shadow_lite allegro orca; do
-    step "bench_${task}_${robot}" "$out/bench_warp.jsonl" python3 -m roto.cli bench --backend warp --device cuda \
-      --task "$task" --robot "$robot" --num_envs "$num_envs" --steps 200 --json
-  done
+all_pairs="bounce:shadow bounce:shadow_lite bounce:allegro bounce:orca baoding:shadow baoding:shadow_lite baoding:allegro baoding:orca"
+read -r -a pytest_files <<< "${PYTEST_FILES:-tests/envs/test_sync_free_step.py tests/rl/test_training_gpu.py tests/rl/test_graphed_step.py}"
+step pytest_gpu "$out/pytest_gpu.txt" python3 -m pytest -q -m gpu -p no:cacheprovider "${pytest_files[@]}"
+for agent in ${UPDATE_AGENTS:-bounce}; do
+  step "update_cost_$agent" "$out/update_cost.jsonl" python3 benchmarks/update_cost.py --device cuda \
+    --num_envs "$num_envs" --agent_cfg "$agent"
 done
-for n in 1024 4096 8192 16384 32768; do
+for pair in ${PAIRS:-$all_pairs}; do
+  task=${pair%%:*} robot=${pair#*:}
+  step "bench_${task}_${robot}" "$out/bench_warp.jsonl" python3 -m roto.cli bench --backend warp --device cuda \
+    --task "$task" --robot "$robot" --num_envs "$num_envs" --steps 200 --json
+done
+for n in ${SCALING-1024 4096 8192 16384 32768}; do
   step "scaling_$n" "$out/scaling.jsonl" python3 -m roto.cli bench --backend warp --device cuda \
     --task bounce --robot shadow --num_envs "$n" --steps 200 --json
 done
+if [ -n "${DEADLINE:-}" ]; then
+  left=$(( DEADLINE - $(date +%s) - 60 ))
+  if [ "$left" -lt "$train_s" ]; then train_s=$(( left > 0 ? left : 0 )); fi
+fi
 if [ "$train_s" -gt 0 ]; then
   run="$out/train_bounce_shadow"
   # SIGINT at the time limit ends the run like Ctrl-C (exit 124 from timeout is the expected end)

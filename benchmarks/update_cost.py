@@ -21,7 +21,7 @@ import torch
 
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
-from roto.rl.build import build_learner, build_model, stacked_sizes
+from roto.rl.build import build_learner, build_model, extra_groups, stacked_sizes
 from roto.rl.config import load_agent_config
 from roto.rl.ppo import PPO
 
@@ -45,9 +45,10 @@ def measure(args: argparse.Namespace, graphed: bool, tf32: bool) -> dict[str, ob
     """Median seconds per update of one variant."""
     device = torch.device(args.device)
     torch.backends.cuda.matmul.allow_tf32 = tf32
-    probe = RotoEnv(EnvConfig(task=args.task, robot=args.robot, num_envs=1))
-    sizes, num_actions = stacked_sizes(probe), probe.num_actions
     agent = load_agent_config(args.task, args.agent_cfg, [f"ppo.cuda_graph={str(graphed).lower()}"])
+    groups = extra_groups(agent, "blind")  # a privileged critic's groups come from the env too
+    probe = RotoEnv(EnvConfig(task=args.task, robot=args.robot, num_envs=1, extra_groups=groups))
+    sizes, num_actions = stacked_sizes(probe), probe.num_actions
     torch.manual_seed(0)
     model = build_model(sizes, num_actions, agent, "blind").to(device)
     alg = build_learner(model, sizes, num_actions, args.num_envs, agent, seed=0, touch="binary")

@@ -160,7 +160,13 @@ def _cmd_train(args: argparse.Namespace) -> int:
             )
         trainer = Trainer.open(run_dir, spec, wandb_project=wandb_project)
     print(f"run directory: {trainer.run_dir}", file=sys.stderr)
-    last = trainer.train(progress=not args.no_progress)
+    try:
+        last = trainer.train(progress=not args.no_progress)
+    except KeyboardInterrupt:  # Ctrl-C or a time limit's SIGINT: a stop, not an error
+        print(f"roto train: interrupted at update {trainer.update}; `roto train --resume {trainer.run_dir}` "
+              f"continues from its latest checkpoint (written every {trainer.agent.run.checkpoint_every} updates)",
+              file=sys.stderr)  # fmt: skip
+        return 130
     plot_learning_curve(trainer.run_dir)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
     summary.update({k.removeprefix("eval/"): v for k, v in last.items()})

@@ -78,14 +78,17 @@ def test_eval_prints_and_writes_json(trained_run, tmp_path, capsys):
     assert {"return_mean", "return_std", "bounces_mean", "length_mean"} <= printed.keys()
 
 
-def test_eval_reads_a_policy_only_checkpoint_as_gpu_suite_writes_it(trained_run, tmp_path, capsys):
+def test_eval_reads_a_gpu_trained_policy_only_checkpoint_as_gpu_suite_writes_it(trained_run, tmp_path, capsys):
     import torch
+
+    from roto.rl.run_dir import POLICY_KEYS
 
     full = trained_run / "checkpoints" / "latest.pt"
     state = torch.load(full, weights_only=True)
-    keep = ("model", "train", "agent", "update", "env_steps", "best_eval_return", "last_eval")
     policy = tmp_path / "policy_latest.pt"
-    torch.save({k: state[k] for k in keep}, policy)  # as benchmarks/gpu_suite.sh keeps it: no env state
+    gpu = {k: state[k] for k in POLICY_KEYS}  # as benchmarks/gpu_suite.sh keeps it: no env state
+    gpu["train"]["env"].update(backend="warp", device="cuda")  # trained on a GPU; evaluated on this CPU
+    torch.save(gpu, policy)
     results = []
     for checkpoint in (full, policy):
         capsys.readouterr()
@@ -182,6 +185,28 @@ def test_train_refuses_an_existing_run_and_leaves_it_untouched(trained_run, caps
     assert main(args) == 2
     assert f"already holds a run; continue it with --resume '{trained_run}'" in capsys.readouterr().err
     assert all(path.read_bytes() == data for path, data in before.items())
+
+
+def test_ctrl_c_stops_training_with_the_resume_command_and_the_resume_finishes(tmp_path, monkeypatch, capsys):
+    from roto.rl.ppo import PPO
+
+    run_dir = tmp_path / "run"
+    update = PPO.update
+    calls = []
+
+    def interrupted_second_update(self):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt  # what Ctrl-C or `timeout --signal=INT` raises
+        return update(self)
+
+    monkeypatch.setattr(PPO, "update", interrupted_second_update)
+    args = ["train", "--num_envs", "4", "--steps", "48", "--run_dir", str(run_dir), "--no_progress", *TINY]
+    assert main(args) == 130
+    err = capsys.readouterr().err
+    assert f"interrupted at update 1; `roto train --resume {run_dir}` continues" in err and "Traceback" not in err
+    assert main(["train", "--resume", str(run_dir), "--no_progress"]) == 0  # the run is not left locked
+    assert json.loads(capsys.readouterr().out.strip().splitlines()[-1])["updates"] == 3
 
 
 def test_resume_refuses_overrides_and_a_budget_below_what_is_done(trained_run, capsys):

@@ -121,10 +121,18 @@ class EnvConfig:
                     "(backend='warp' simulates on a CUDA device)"
                 )
             return
-        if importlib.util.find_spec("mujoco_warp") is None:
-            raise ValueError("backend 'warp' needs MuJoCo Warp, which is not installed: pip install -e '.[gpu]'")
         if device != "cpu" and not (device == "cuda" or device.startswith("cuda:")):
             raise ValueError(f"device {device!r} is not valid with backend 'warp'; valid: ['cpu', 'cuda', 'cuda:<k>']")
+
+    def check_available(self) -> None:
+        """Raise ValueError unless this machine can build these envs: MuJoCo Warp installed for
+        backend 'warp', a CUDA GPU for a CUDA device. Checked when envs are made, not when a config
+        is read, so a GPU-trained run's config (a checkpoint's) loads anywhere for CPU evaluation."""
+        if self.backend == "cpu":
+            return
+        device = str(self.device)
+        if importlib.util.find_spec("mujoco_warp") is None:
+            raise ValueError("backend 'warp' needs MuJoCo Warp, which is not installed: pip install -e '.[gpu]'")
         if device.startswith("cuda"):
             import torch
 

@@ -67,6 +67,7 @@ class RotoEnv:
     metadata: ClassVar[dict[str, Any]] = {"autoreset_mode": gym.vector.AutoresetMode.SAME_STEP}
 
     def __init__(self, config: EnvConfig) -> None:
+        config.check_available()
         self.config = config
         self.task = get_task(config.task)
         self.robot: RobotSpec = get_robot(config.robot)
