@@ -71,3 +71,15 @@ def test_summaries_of_an_older_or_unrecorded_task_version_get_no_reference_colum
     md = (tmp_path / "out" / "results.md").read_text()
     assert "baoding (older or unrecorded version) / blind / ppo" in md and "bounce (v0) / blind / ppo" in md
     assert "reference controller" not in md and "scripted Bounce (bounces, v0)" in md
+
+
+def test_no_roto_v1_row_where_no_column_is_roto_agent():
+    import numpy as np
+
+    from roto.olympiad.results import markdown_table
+
+    scores = {("baoding", "shadow", "blind", "recipe"): np.array([10.0])}
+    plain = markdown_table(scores, {("baoding", "recipe"): {"label": "baoding_cpu + aids"}}, {"baoding"})
+    assert "roto v1" not in plain and "| shadow | 10.0 ± 0.0" in plain
+    roto = markdown_table(scores, {("baoding", "recipe"): {"label": "roto's", "roto_agent": "ppo"}}, {"baoding"})
+    assert "| roto v1, Shadow, 200 M steps (5 seeds) | 5.1 (ppo) |  |" in roto
