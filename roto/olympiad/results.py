@@ -132,7 +132,8 @@ def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None, 
         figure = ROTO_V1_SHADOW.get((task, obs, roto_agent)) if roto_agent else None
         reference.append(f"{figure} ({roto_agent})" if figure is not None else "")
     if any(reference):  # no row of blanks where no column is roto's agent
-        lines.append("| " + " | ".join(["roto v1, Shadow, 200 M steps (5 seeds)", *reference, *[""] * len(tasks)]) + " |")
+        row = ["roto v1, Shadow, 200 M steps (5 seeds)", *reference, *[""] * len(tasks)]
+        lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines)
 
 
