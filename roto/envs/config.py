@@ -44,6 +44,10 @@ class EnvConfig:
         replay_share: the share of episode starts drawn from ``replay_starts`` instead of the
             task's own starts (0: none). Training only: evaluation envs always start from the
             task's own starts (``without_training_aids``).
+        replay_record_lead: a training aid beside ``replay_starts`` (0: off): the training envs'
+            own states this many control steps before each rise of the task's headline metric
+            (a Baoding swap) join the bank they replay from (``roto.envs.event_recorder``).
+        replay_record_capacity: the most states so recorded (the oldest replaced first).
     """
 
     task: str
@@ -66,6 +70,8 @@ class EnvConfig:
     njmax: int | None = None
     replay_starts: str | None = None
     replay_share: float = 0.0
+    replay_record_lead: int = 0
+    replay_record_capacity: int = 1024
 
     def __post_init__(self) -> None:
         """Reject impossible values with a message naming the value and the valid choices."""
@@ -103,7 +109,7 @@ class EnvConfig:
 
     def without_training_aids(self) -> EnvConfig:
         """This config as the benchmark defines the task: no replayed starts."""
-        return dataclasses.replace(self, replay_starts=None, replay_share=0.0)
+        return dataclasses.replace(self, replay_starts=None, replay_share=0.0, replay_record_lead=0)
 
     def _check_replay(self) -> None:
         share = self.replay_share
@@ -111,6 +117,15 @@ class EnvConfig:
             raise ValueError(f"replay_share must be a number in [0, 1], got {share!r}")
         if share > 0.0 and self.replay_starts is None:
             raise ValueError(f"replay_share {share} needs replay_starts (an .npz of recorded states); got none")
+        for name, low in (("replay_record_lead", 0), ("replay_record_capacity", 1)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+        if self.replay_record_lead > 0 and share == 0.0:
+            raise ValueError(
+                f"replay_record_lead {self.replay_record_lead} records states for replayed starts, but replay_share "
+                "is 0 (nothing would replay them); set replay_share and replay_starts"
+            )
 
     def _check_device(self) -> None:
         device = str(self.device)

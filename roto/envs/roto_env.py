@@ -22,6 +22,7 @@ import torch
 from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
+from roto.envs.event_recorder import EventRecorder, event_recorder_for, record_events
 from roto.envs.frames import observation_frame
 from roto.envs.indices import SceneIndices
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, task_frame
@@ -94,6 +95,7 @@ class RotoEnv:
         self.replay_bank = self._load_replay_bank()
         replaying = self.replay_bank is not None and config.replay_share > 0.0
         self._replayed_task_fields = tuple(self.replay_bank.task) if replaying else ()
+        self.recorder = event_recorder_for(self)  # None unless the config records its own events
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
@@ -170,6 +172,8 @@ class RotoEnv:
         obs = self._stack.observation()
 
         done = terminated | truncated
+        if self.recorder is not None:
+            record_events(self, sim, done)
         info: dict[str, Any] = {"reward_terms": result.reward_terms, "nonfinite": diverged}
         # a step without resets skips them, unless asking would wait for the device: then the reset
         # runs every step, masked (a world that did not finish is left as it was)
@@ -208,6 +212,7 @@ class RotoEnv:
             "nonfinite_resets": self.nonfinite_resets,
             "needs_reset": self._needs_reset,
             **({"replay_bank": self.replay_bank.state_dict()} if self.replay_bank is not None else {}),
+            **({"event_recorder": self.recorder.state_dict()} if self.recorder is not None else {}),
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -228,6 +233,8 @@ class RotoEnv:
             self._starts.clear()
         if "replay_bank" in state:  # the states the run drew from, whatever the file holds now
             self.replay_bank = ReplayBank.from_state_dict(state["replay_bank"], self.device)
+        if "event_recorder" in state:
+            self.recorder = EventRecorder.from_state_dict(state["event_recorder"], self.device)
         self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
         if not self._needs_reset:  # the pool covers the steps until the next check (same draws, earlier)

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import torch
 
+from roto.envs.event_recorder import with_recorded
 from roto.envs.start_pool import contact_depth, draw_valid_starts
 from roto.tasks.base import uniform
 
@@ -50,7 +51,10 @@ def replayed_starts(env: RotoEnv, n: int, generator: torch.Generator) -> dict[st
     """n starts drawn uniformly from the env's bank of recorded states: their qpos, qvel, joint
     targets, recorded task state ("task/<field>") and first frame, rows as ``draw_starts``'."""
     bank = env.replay_bank
-    pick = torch.randint(len(bank), (n,), generator=generator, device=env.device)
+    if env.recorder is None:
+        pick = torch.randint(len(bank), (n,), generator=generator, device=env.device)
+    else:  # the file's states and the env's own recorded ones, drawn alike
+        bank, pick = with_recorded(bank, env.recorder, n, generator)
     qpos, qvel, target = bank.qpos[pick], bank.qvel[pick], bank.target[pick]
     task_rows = {name: values[pick] for name, values in bank.task.items()}
     frame, _ = first_frame(env, qpos, qvel, target, task_rows)
