@@ -44,7 +44,7 @@ def export_best(
     header = [
         f"# roto sweep export: study {name!r}, trial {best.number}"
         f" ({'the best' if best.number == study.best_trial.number else 'chosen'}),"
-        f" best evaluation return {best.value:.3f}"
+        f" best evaluation {_objective_name(settings)} {best.value:.6g}"
         f" (seed {best.user_attrs.get('seed')}, {settings['steps']} env steps)",
         f"# base config: {settings['agent_cfg'] or settings['task'] + ' (default)'}; search space: {settings['space']}",
         f"# train with: roto train --task {settings['task']} --robot {settings['robot']} --obs {settings['obs']}"
@@ -143,3 +143,10 @@ def show(name: str, root: str, storage_url: str | None) -> str:
 
 def _short(value: object) -> str:
     return f"{value:.3g}" if isinstance(value, float) else str(value)
+
+
+def _objective_name(settings: dict) -> str:
+    """What a study's trial values are (its stored objective; studies stored before it: the return)."""
+    if settings.get("objective", "return") == "return":
+        return "return"
+    return "headline metric (+1e-6 x return)"

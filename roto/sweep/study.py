@@ -20,6 +20,11 @@ STUDY_NAME = re.compile(r"[A-Za-z0-9._-]+")
 SEEDS = (0, 1, 2, 3, 4)
 """Each trial trains with one of these seeds, drawn per trial (docs/spec.md §8)."""
 SETTINGS_ATTR = "roto:settings"
+OBJECTIVES = ("return", "metric")
+"""What trials maximise: the best evaluation's mean return, or the task's headline metric with the
+return breaking ties (``roto.sweep.trial.objective_value``)."""
+IDENTITY_DEFAULTS = {"objective": "return"}
+"""Identity fields added since studies were first stored: a stored study without one had this."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -35,6 +40,8 @@ class SweepSettings:
     overrides: tuple[str, ...] = ()
     """``section.key=value`` overrides every trial gets (env and agent keys) under the searched ones."""
     space: str = "roto2"
+    objective: str = "return"
+    """``return`` or ``metric`` (``OBJECTIVES``)."""
     trials: int = 40
     """Trials that finish (complete or pruned); failed ones are retried or replaced. Not part of the
     study's identity: rerunning with a larger count extends the study."""
@@ -55,6 +62,8 @@ class SweepSettings:
     def __post_init__(self) -> None:
         """Reject values no sweep can use."""
         check_study_name(self.study)
+        if self.objective not in OBJECTIVES:
+            raise ValueError(f"unknown objective {self.objective!r}; valid objectives: {list(OBJECTIVES)}")
         for name in ("trials", "steps", "num_envs", "threads"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
@@ -73,13 +82,14 @@ class SweepSettings:
 
     def identity(self) -> dict[str, Any]:
         """The settings that define the study's trials (stored on the study, checked on joining)."""
-        keep = ("task", "robot", "obs", "agent_cfg", "overrides", "space", "steps", "num_envs")
+        keep = ("task", "robot", "obs", "agent_cfg", "overrides", "space", "objective", "steps", "num_envs")
         data = {k: getattr(self, k) for k in keep}
         data["overrides"] = list(self.overrides)
         return data
 
     def with_identity(self, identity: dict[str, Any]) -> SweepSettings:
         """These settings with the study-defining ones taken from ``identity``."""
+        identity = {**IDENTITY_DEFAULTS, **identity}
         return dataclasses.replace(self, **{**identity, "overrides": tuple(identity["overrides"])})
 
 
@@ -107,6 +117,7 @@ def open_study(settings: SweepSettings) -> tuple[optuna.Study, optuna.storages.B
     if stored is None:
         study.set_user_attr(SETTINGS_ATTR, settings.identity())
         return study, storage
+    stored = {**IDENTITY_DEFAULTS, **stored}
     differ = {k: (stored.get(k), v) for k, v in settings.identity().items() if stored.get(k) != v}
     if differ:
         raise ValueError(

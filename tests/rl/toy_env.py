@@ -19,6 +19,7 @@ EPISODE_STEPS = 8
 @dataclass(frozen=True)
 class _ToyTask:
     metric_names: tuple[str, ...] = ("hits",)
+    headline_metric: str = "hits"
 
 
 class ToyEnv:

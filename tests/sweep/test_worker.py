@@ -151,6 +151,32 @@ def test_diverging_trials_end_pruned_with_the_reason_and_the_study_goes_on(tmp_p
     assert all("non-finite" in t.user_attrs[REASON_ATTR] for t in finished)
 
 
+def test_a_metric_objective_ranks_trials_by_the_headline_metric_with_the_return_breaking_ties(tmp_path):
+    torch.set_num_threads(1)
+    settings = toy_settings(tmp_path, trials=2, objective="metric")
+    assert run_worker(settings, env_factory=ToyEnv) == 2
+    for trial in finished_trials(settings)[1]:
+        records = read_evaluations(run_dir_of(settings, trial.number))
+        values = [r["hits_mean"] + 1e-6 * r["return_mean"] for r in records]
+        assert trial.value == max(values) and trial.intermediate_values[records[-1]["env_steps"]] == max(values)
+    with pytest.raises(ValueError, match=r"'objective': \('metric', 'return'\)"):
+        open_study(toy_settings(tmp_path, trials=2))  # the stored objective is part of the study
+    with pytest.raises(ValueError, match=r"unknown objective 'rotations'; valid objectives: \['return', 'metric'\]"):
+        toy_settings(tmp_path, trials=2, objective="rotations")
+
+
+def test_a_study_stored_before_objectives_existed_is_joined_as_a_return_study(tmp_path):
+    from roto.sweep.study import SETTINGS_ATTR
+
+    settings = toy_settings(tmp_path, trials=2)
+    study, _ = open_study(settings)
+    old = {k: v for k, v in settings.identity().items() if k != "objective"}
+    study.set_user_attr(SETTINGS_ATTR, old)
+    open_study(settings)  # joins
+    with pytest.raises(ValueError, match=r"'objective': \('return', 'metric'\)"):
+        open_study(toy_settings(tmp_path, trials=2, objective="metric"))
+
+
 def test_joining_a_study_with_other_settings_is_an_error(tmp_path):
     open_study(toy_settings(tmp_path, trials=4))
     with pytest.raises(ValueError, match=r"exists with other settings.*'steps': \(192, 320\)"):
