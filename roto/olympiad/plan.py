@@ -12,8 +12,10 @@ A plan is a YAML file::
         baoding: {overrides: [ppo.epochs=4], roto_agent: ppo}  # compared with roto v1's PPO
       force_touch:
         bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004, env.touch=force]}
-      replayed:             # {robot} in an override becomes each cell's hand
+      replayed:             # {robot} in an override or the agent config becomes each cell's hand
         baoding: {overrides: ["env.replay_starts=starts/{robot}.npz", env.replay_share=0.25]}
+      tuned:                # a config per hand (each must exist for every hand the grids name)
+        bounce: {agent_cfg: "bounce_cpu_{robot}"}
     grids:                  # the cells: the union of these products
       - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0, 1]}
 
@@ -84,10 +86,13 @@ class Variant:
 
     def agent_for(self, task: str, robot: str | None = None) -> tuple[str | None, list[str]]:
         """(agent config, overrides) this variant trains ``task`` with; with ``robot``, ``{robot}``
-        in an override becomes the robot's name (a per-hand file, e.g. replayed starts)."""
+        in the agent config or an override becomes the robot's name (a per-hand config, a per-hand
+        file such as replayed starts)."""
         entry = self.for_task(task)
-        overrides = [o.replace(ROBOT_FIELD, robot) for o in entry.overrides] if robot else list(entry.overrides)
-        return entry.agent_cfg, overrides
+        if robot is None:
+            return entry.agent_cfg, list(entry.overrides)
+        agent_cfg = entry.agent_cfg.replace(ROBOT_FIELD, robot) if entry.agent_cfg else entry.agent_cfg
+        return agent_cfg, [o.replace(ROBOT_FIELD, robot) for o in entry.overrides]
 
 
 @dataclass(frozen=True, order=True)

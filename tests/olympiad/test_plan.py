@@ -114,3 +114,26 @@ def test_robot_in_an_override_becomes_each_cells_hand():
     assert all(
         pathlib.Path(f"benchmarks/results/baoding_reference/{c.robot}_preswap.npz").is_file() for c in plan.cells
     )
+
+
+def test_robot_in_an_agent_config_names_a_config_per_hand_and_a_missing_one_is_refused(tmp_path):
+    from roto.olympiad.cell import cell_spec
+    from roto.olympiad.plan import Cell
+
+    for robot, lr in (("shadow", 1.0e-4), ("allegro", 3.0e-4)):
+        (tmp_path / f"tuned_{robot}.yaml").write_text(f"extends: bounce_cpu_quickstart\nppo:\n  lr: {lr}\n")
+    plan_text = """steps: 1000
+variants:
+  tuned:
+    bounce: {agent_cfg: "%s/tuned_{robot}.yaml"}
+grids:
+  - {tasks: [bounce], robots: [%s], obs: [blind], variants: [tuned], seeds: [0]}
+"""
+    plan_file = tmp_path / "plan.yaml"
+    plan_file.write_text(plan_text % (tmp_path, "shadow, allegro"))
+    plan = load_plan(str(plan_file))
+    specs = {robot: cell_spec(plan, Cell("bounce", robot, "blind", "tuned", 0)) for robot in ("shadow", "allegro")}
+    assert specs["shadow"].agent.ppo.lr == 1.0e-4 and specs["allegro"].agent.ppo.lr == 3.0e-4
+    plan_file.write_text(plan_text % (tmp_path, "shadow, orca"))
+    with pytest.raises(ValueError, match=r"variant 'tuned' on bounce/orca/blind: .*tuned_orca.yaml"):
+        load_plan(str(plan_file))
