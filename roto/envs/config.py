@@ -48,6 +48,11 @@ class EnvConfig:
             own states this many control steps before each rise of the task's headline metric
             (a Baoding swap) join the bank they replay from (``roto.envs.event_recorder``).
         replay_record_capacity: the most states so recorded (the oldest replaced first).
+        tolerance_start: a training aid for a task with a success radius (Baoding; 0: off): the
+            radius starts this wide (m) and narrows to the task's own as the training episodes'
+            headline metric rises (``roto.envs.tolerance_curriculum``).
+        tolerance_target: the headline metric per training episode (Baoding: rotations) at which
+            the radius is the task's own.
     """
 
     task: str
@@ -72,6 +77,8 @@ class EnvConfig:
     replay_share: float = 0.0
     replay_record_lead: int = 0
     replay_record_capacity: int = 1024
+    tolerance_start: float = 0.0
+    tolerance_target: float = 1.0
 
     def __post_init__(self) -> None:
         """Reject impossible values with a message naming the value and the valid choices."""
@@ -105,11 +112,14 @@ class EnvConfig:
             if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
                 raise ValueError(f"{name} must be an integer >= 1 or None, got {value!r}")
         self._check_replay()
+        self._check_tolerance()
         self._check_device()
 
     def without_training_aids(self) -> EnvConfig:
         """This config as the benchmark defines the task: no replayed starts."""
-        return dataclasses.replace(self, replay_starts=None, replay_share=0.0, replay_record_lead=0)
+        return dataclasses.replace(
+            self, replay_starts=None, replay_share=0.0, replay_record_lead=0, tolerance_start=0.0
+        )
 
     def _check_replay(self) -> None:
         share = self.replay_share
@@ -125,6 +135,26 @@ class EnvConfig:
             raise ValueError(
                 f"replay_record_lead {self.replay_record_lead} records states for replayed starts, but replay_share "
                 "is 0 (nothing would replay them); set replay_share and replay_starts"
+            )
+
+    def _check_tolerance(self) -> None:
+        from roto.tasks import get_task
+
+        start, target = self.tolerance_start, self.tolerance_target
+        for name, value in (("tolerance_start", start), ("tolerance_target", target)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0.0:
+                raise ValueError(f"{name} must be a number >= 0, got {value!r}")
+        if start == 0.0:
+            return
+        own = getattr(get_task(self.task), "success_radius", None)
+        if own is None:
+            raise ValueError(
+                f"tolerance_start applies to a task with a success radius (baoding); task {self.task!r} has none"
+            )
+        if start < own or target <= 0.0:
+            raise ValueError(
+                f"tolerance_start must be at least the task's own radius {own} m and tolerance_target > 0, "
+                f"got {start}, {target}"
             )
 
     def _check_device(self) -> None:

@@ -31,6 +31,7 @@ from roto.envs.selections import Selected, Selections
 from roto.envs.spaces import BoundedBox
 from roto.envs.start_draw import draw_candidates, draw_starts
 from roto.envs.start_pool import StartPool, check_balls_start_clear
+from roto.envs.tolerance_curriculum import tolerance_curriculum_for, update_tolerance
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
 from roto.sim.backend import Backend, make_backend
@@ -96,6 +97,7 @@ class RotoEnv:
         replaying = self.replay_bank is not None and config.replay_share > 0.0
         self._replayed_task_fields = tuple(self.replay_bank.task) if replaying else ()
         self.recorder = event_recorder_for(self)  # None unless the config records its own events
+        self.curriculum = tolerance_curriculum_for(self)  # None unless the config widens the task's radius
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
@@ -174,6 +176,8 @@ class RotoEnv:
         done = terminated | truncated
         if self.recorder is not None:
             record_events(self, sim, done)
+        if self.curriculum is not None:
+            update_tolerance(self, done)
         info: dict[str, Any] = {"reward_terms": result.reward_terms, "nonfinite": diverged}
         # a step without resets skips them, unless asking would wait for the device: then the reset
         # runs every step, masked (a world that did not finish is left as it was)
@@ -213,6 +217,7 @@ class RotoEnv:
             "needs_reset": self._needs_reset,
             **({"replay_bank": self.replay_bank.state_dict()} if self.replay_bank is not None else {}),
             **({"event_recorder": self.recorder.state_dict()} if self.recorder is not None else {}),
+            **({"tolerance_curriculum": self.curriculum.state_dict()} if self.curriculum is not None else {}),
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -235,6 +240,8 @@ class RotoEnv:
             self.replay_bank = ReplayBank.from_state_dict(state["replay_bank"], self.device)
         if "event_recorder" in state:
             self.recorder = EventRecorder.from_state_dict(state["event_recorder"], self.device)
+        if "tolerance_curriculum" in state:
+            self.curriculum.load_state_dict(state["tolerance_curriculum"])
         self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
         if not self._needs_reset:  # the pool covers the steps until the next check (same draws, earlier)

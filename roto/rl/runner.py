@@ -209,7 +209,10 @@ class Trainer:
             self.episodes.add(info)
             t_inference += t1 - t0
             t_sim += t2 - t1
-        return {"perf/inference_s": t_inference, "perf/simulation_s": t_sim}
+        scalars = {"perf/inference_s": t_inference, "perf/simulation_s": t_sim}
+        if getattr(self.env, "curriculum", None) is not None:  # a training aid's state, read once per update
+            scalars["train/success_radius"] = float(self.env.task_state.radius)
+        return scalars
 
     def _evaluate(self) -> dict[str, float]:
         """Evaluate the current weights; ``best.pt`` gets them when they beat every earlier evaluation."""

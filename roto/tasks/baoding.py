@@ -96,10 +96,15 @@ class BaodingState:
     swapped: torch.Tensor  # (B,) bool: ball a aims at T_b and ball b at T_a
     latched: torch.Tensor  # (B, 2) bool: ball i has reached its current target
     swaps: torch.Tensor  # (B,) int64
+    radius: torch.Tensor  # () float64: the success radius (SUCCESS_RADIUS; a training curriculum may widen it)
 
 
 def baoding_rule(
-    ball_pos: torch.Tensor, targets: torch.Tensor, swapped: torch.Tensor, latched: torch.Tensor
+    ball_pos: torch.Tensor,
+    targets: torch.Tensor,
+    swapped: torch.Tensor,
+    latched: torch.Tensor,
+    radius: float | torch.Tensor = SUCCESS_RADIUS,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
     """One step of the latch-and-swap rule (pure; torch or numpy).
 
@@ -108,13 +113,14 @@ def baoding_rule(
         targets: (2, 3) T_a, T_b.
         swapped: (B,) bool, current assignment (False: ball a -> T_a, ball b -> T_b).
         latched: (B, 2) bool latches.
+        radius: a ball this near its current target (m) sets its latch.
 
     Returns:
         (distances (B, 2) to the targets used this step, swap (B,) bool, new swapped, new latched)
     """
     current = where(swapped[:, None, None], flip_rows(targets)[None], targets[None])
     dist = vector_norm(ball_pos - current)
-    latched = latched | (dist < SUCCESS_RADIUS)
+    latched = latched | (dist < radius)
     swap = latched.all(axis=1)
     swapped = swapped ^ swap
     latched = latched & ~swap[:, None]
@@ -131,6 +137,8 @@ class Baoding:
     on targets where they rest, partly inside the hand."""
     metric_names = ("swaps", "rotations")
     headline_metric = "rotations"
+    success_radius = SUCCESS_RADIUS
+    """The benchmark's latch radius (m); a training curriculum may start wider (``roto.envs.tolerance_curriculum``)."""
     reference_name = "reference controller"
     reference = MappingProxyType({"shadow": 7.31, "shadow_lite": 5.50, "allegro": 5.03, "orca": 5.78})
     """Rotations per 10 s of the predictive-sampling reference controller, 16 episodes each,
@@ -152,6 +160,7 @@ class Baoding:
             swapped=torch.zeros(num_envs, dtype=torch.bool, device=device),
             latched=torch.zeros(num_envs, 2, dtype=torch.bool, device=device),
             swaps=torch.zeros(num_envs, dtype=torch.int64, device=device),
+            radius=torch.tensor(SUCCESS_RADIUS, dtype=torch.float64, device=device),
         )
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:
@@ -169,7 +178,9 @@ class Baoding:
     def step(self, state: BaodingState, inputs: TaskInputs) -> StepResult:
         """Latch, swap (+10), dense shaping; end when the balls part or drop."""
         pos = inputs.ball_pos
-        dist, swap, state.swapped, state.latched = baoding_rule(pos, state.targets, state.swapped, state.latched)
+        dist, swap, state.swapped, state.latched = baoding_rule(
+            pos, state.targets, state.swapped, state.latched, state.radius
+        )
         state.swaps += swap
         dense = DENSE_SCALE * (1.0 - tanh(dist / DENSE_LENGTH)).sum(axis=1)
         parted = squared_norm(pos[:, 0] - pos[:, 1]) >= MAX_SEPARATION**2

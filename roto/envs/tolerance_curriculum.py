@@ -1,0 +1,77 @@
+"""A training-only tolerance curriculum: the task's success radius starts wide and narrows to the
+benchmark's as the training episodes succeed.
+
+For a task with a success radius (Baoding's latch radius, ``Task.success_radius``): the radius is
+``end + (start - end) * max(0, 1 - mean / target)``, where ``mean`` is a running mean of the headline
+metric (Baoding: rotations) over the training episodes that ended so far (each ended episode
+weighs ``EPISODE_WEIGHT``), ``start`` is ``EnvConfig.tolerance_start`` and ``end`` the task's own
+radius. So the radius is ``start`` while no episode succeeds, the task's own once the episodes
+reach ``EnvConfig.tolerance_target`` on average, and widens again if they fall back. The update
+runs on the env's device in fixed shapes, never reading it. Evaluation envs never use it
+(``EnvConfig.without_training_aids``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import torch
+
+if TYPE_CHECKING:
+    from roto.envs.roto_env import RotoEnv
+
+EPISODE_WEIGHT = 0.01
+"""Weight of one ended episode in the running mean (about the last hundred episodes count)."""
+
+
+@dataclass
+class ToleranceCurriculum:
+    """Attributes: start and end radius (m), the target headline metric per episode, and the
+    running mean of that metric over ended training episodes (a () float64 tensor)."""
+
+    start: float
+    end: float
+    target: float
+    mean: torch.Tensor
+
+    def radius(self) -> torch.Tensor:
+        """() float64, the success radius for the running mean now."""
+        progress = torch.clamp(1.0 - self.mean / self.target, 0.0, 1.0)
+        return self.end + (self.start - self.end) * progress
+
+    def update(self, metric: torch.Tensor, done: torch.Tensor) -> torch.Tensor:
+        """Fold in the episodes that end now (``done`` (B,) bool, their headline ``metric`` (B,));
+        returns the new radius. k ended episodes move the mean as k updates of weight
+        ``EPISODE_WEIGHT`` towards their mean would."""
+        ended = done.to(torch.float64)
+        count = ended.sum()
+        batch_mean = (metric.to(torch.float64) * ended).sum() / torch.clamp(count, min=1.0)
+        weight = 1.0 - (1.0 - EPISODE_WEIGHT) ** count
+        self.mean = self.mean + weight * (batch_mean - self.mean)
+        return self.radius()
+
+    def state_dict(self) -> dict[str, object]:
+        return {"mean": self.mean.clone()}
+
+    def load_state_dict(self, state: dict[str, object]) -> None:
+        self.mean = state["mean"].clone().to(self.mean.device)
+
+
+def tolerance_curriculum_for(env: RotoEnv) -> ToleranceCurriculum | None:
+    """The curriculum ``env.config`` asks for (``tolerance_start`` > 0), its task's radius set to the
+    start; None when it asks for none."""
+    config = env.config
+    if config.tolerance_start == 0.0:
+        return None
+    mean = torch.zeros((), dtype=torch.float64, device=env.device)
+    curriculum = ToleranceCurriculum(config.tolerance_start, env.task.success_radius, config.tolerance_target, mean)
+    env.task_state.radius.copy_(curriculum.radius())
+    return curriculum
+
+
+def update_tolerance(env: RotoEnv, done: torch.Tensor) -> None:
+    """This step's ended episodes into ``env.curriculum``, before their task state resets; the
+    task's radius follows."""
+    metric = env.task.metrics(env.task_state)[env.task.headline_metric]
+    env.task_state.radius.copy_(env.curriculum.update(metric, done))

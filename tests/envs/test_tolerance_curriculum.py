@@ -1,0 +1,112 @@
+"""The tolerance curriculum: Baoding's latch radius starts wide, narrows as training episodes
+rotate, is saved with the env, is refused where a task has no radius, and never reaches evaluation."""
+
+import pytest
+import torch
+
+import roto
+from roto.envs.config import EnvConfig
+from roto.envs.tolerance_curriculum import EPISODE_WEIGHT, ToleranceCurriculum, update_tolerance
+from roto.rl.settings import TrainSettings
+from roto.tasks.baoding import SUCCESS_RADIUS, baoding_rule
+
+
+def curriculum(start=0.025, target=1.0):
+    return ToleranceCurriculum(start, SUCCESS_RADIUS, target, torch.zeros((), dtype=torch.float64))
+
+
+def test_the_radius_narrows_with_the_running_mean_of_ended_episodes():
+    c = curriculum()
+    assert float(c.radius()) == pytest.approx(0.025)
+    done = torch.tensor([True, True, False, True])
+    metric = torch.tensor([0.5, 0.5, 7.0, 0.5])  # the world still running does not count
+    c.update(metric, done)
+    # three episodes of 0.5, one at a time, each moving the mean a weight of EPISODE_WEIGHT towards 0.5
+    mean = 0.0
+    for _ in range(3):
+        mean += EPISODE_WEIGHT * (0.5 - mean)
+    assert float(c.mean) == pytest.approx(mean)
+    assert float(c.radius()) == pytest.approx(SUCCESS_RADIUS + 0.015 * (1.0 - mean))
+    before = float(c.mean)
+    c.update(metric, torch.zeros(4, dtype=torch.bool))  # nothing ended: nothing moves
+    assert float(c.mean) == before
+    for _ in range(2000):  # episodes at the target: the task's own radius
+        c.update(torch.full((4,), 1.0), torch.ones(4, dtype=torch.bool))
+    assert float(c.radius()) == pytest.approx(SUCCESS_RADIUS, abs=1e-9)
+
+
+def test_a_wider_radius_latches_a_ball_the_benchmarks_would_not():
+    targets = torch.tensor([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]], dtype=torch.float64)
+    pos = torch.tensor([[[0.02, 0.0, 0.0], [0.5, 0.0, 0.0]]], dtype=torch.float64)  # ball a 2 cm from T_a
+    none = torch.zeros(1, dtype=torch.bool)
+    latches = torch.zeros(1, 2, dtype=torch.bool)
+    assert not baoding_rule(pos, targets, none, latches)[3].any()
+    assert baoding_rule(pos, targets, none, latches, torch.tensor(0.025, dtype=torch.float64))[3][0, 0]
+
+
+def test_a_baoding_env_starts_wide_narrows_as_its_episodes_rotate_and_resumes_exactly():
+    env = roto.make("baoding", robot="shadow", num_envs=4, seed=0, tolerance_start=0.03, tolerance_target=2.0)
+    assert float(env.task_state.radius) == pytest.approx(0.03)
+    env.reset()
+    env.task_state.swaps.fill_(2)  # every world has made one rotation when its episode ends
+    update_tolerance(env, torch.ones(4, dtype=torch.bool))
+    mean = 1.0 - (1.0 - EPISODE_WEIGHT) ** 4
+    assert float(env.task_state.radius) == pytest.approx(SUCCESS_RADIUS + 0.02 * (1.0 - mean / 2.0))
+    saved = env.state_dict()
+    other = roto.make("baoding", robot="shadow", num_envs=4, seed=5, tolerance_start=0.03, tolerance_target=2.0)
+    other.load_state_dict(saved)
+    assert torch.equal(other.curriculum.mean, env.curriculum.mean)
+    assert torch.equal(other.task_state.radius, env.task_state.radius)
+    plain = roto.make("baoding", robot="shadow", num_envs=4, seed=0)
+    assert plain.curriculum is None and float(plain.task_state.radius) == SUCCESS_RADIUS
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "pattern"),
+    [
+        ({"task": "bounce", "tolerance_start": 0.02}, r"task 'bounce' has none"),
+        ({"task": "baoding", "tolerance_start": 0.005}, r"at least the task's own radius 0.01 m"),
+        ({"task": "baoding", "tolerance_start": 0.02, "tolerance_target": 0.0}, r"tolerance_target > 0"),
+        ({"task": "baoding", "tolerance_start": -1.0}, r"tolerance_start must be a number >= 0, got -1.0"),
+    ],
+)
+def test_bad_tolerance_settings_are_refused(kwargs, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        EnvConfig(**kwargs)
+
+
+def test_evaluation_envs_use_the_benchmarks_radius():
+    settings = TrainSettings(env=EnvConfig(task="baoding", tolerance_start=0.025))
+    assert settings.eval_env_config(4).tolerance_start == 0.0 and settings.cpu_env_config(1).tolerance_start == 0.0
+    assert settings.env_config().tolerance_start == 0.025
+
+
+def test_training_logs_the_radius_and_config_yaml_names_the_aid(tmp_path):
+    import csv
+
+    import yaml
+
+    from roto.cli import main
+    from tests.test_cli_training import TINY
+
+    run_dir = tmp_path / "run"
+    args = [
+        "train",
+        "--task",
+        "baoding",
+        "--num_envs",
+        "4",
+        "--steps",
+        "48",
+        "--run_dir",
+        str(run_dir),
+        "--no_progress",
+    ]
+    assert main([*args, *TINY, "env.tolerance_start=0.03"]) == 0
+    radii = [
+        float(r["value"])
+        for r in csv.DictReader((run_dir / "scalars.csv").open())
+        if r["tag"] == "train/success_radius"
+    ]
+    assert len(radii) == 3 and all(SUCCESS_RADIUS <= r <= 0.03 for r in radii)
+    assert yaml.safe_load((run_dir / "config.yaml").read_text())["train"]["env"]["tolerance_start"] == 0.03
