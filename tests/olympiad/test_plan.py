@@ -13,6 +13,7 @@ def test_packaged_plans():
         "variants_baoding",
         "baoding_v1_cpu",
         "baoding_v1_ablations",
+        "baoding_v1_more_aids",
     }
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
@@ -137,3 +138,21 @@ grids:
     plan_file.write_text(plan_text % (tmp_path, "shadow, orca"))
     with pytest.raises(ValueError, match=r"variant 'tuned' on bounce/orca/blind: .*tuned_orca.yaml"):
         load_plan(str(plan_file))
+
+
+def test_the_more_aids_plan_adds_each_aid_to_the_recipe_for_shadow_lite():
+    from roto.olympiad.cell import cell_spec
+
+    plan = load_plan("baoding_v1_more_aids")
+    specs = {c.variant: cell_spec(plan, c) for c in plan.cells}
+    assert {c.robot for c in plan.cells} == {"shadow_lite"} and len(specs) == 4
+    assert all(
+        s.env.replay_starts.endswith("shadow_lite_preswap.npz") and s.agent.ppo.epochs == 4 for s in specs.values()
+    )
+    assert specs["tolerance"].env.tolerance_start == 0.025 and specs["tolerance"].env.replay_record_lead == 0
+    assert specs["record"].env.replay_record_lead == 10 and specs["record"].env.tolerance_start == 0.0
+    assert specs["share_half"].env.replay_share == 0.5
+    everything = specs["all_three"].env
+    assert (
+        everything.replay_share == 0.5 and everything.tolerance_start == 0.025 and everything.replay_record_lead == 10
+    )
