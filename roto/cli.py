@@ -363,6 +363,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
+    except KeyboardInterrupt:  # Ctrl-C: a stop, not an error (a sweep's or Olympiad's trial is retried on the next run)
+        if args.debug:
+            raise
+        print(f"roto {args.command}: interrupted", file=sys.stderr)
+        return 130
     except Exception as error:
         if args.debug:
             raise
