@@ -39,6 +39,8 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
     p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running trial's heartbeats")
     p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
+    p.add_argument("--enqueue_base", "--enqueue-base", dest="enqueue_base", action="store_true",
+                   help="a new study's first trial: the base config's values of the searched parameters")  # fmt: skip
     p.add_argument("--reclaim-now", "--reclaim_now", dest="reclaim_now", action="store_true",
                    help="first fail and retry every running trial (only when no other worker is alive)")  # fmt: skip
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="section.key=value",
@@ -63,7 +65,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from roto.sweep.claims import launch_workers
     from roto.sweep.space import load_space
     from roto.sweep.storage import reclaim_now
-    from roto.sweep.study import SweepSettings, open_study
+    from roto.sweep.study import SweepSettings, enqueue_base, open_study
     from roto.sweep.worker import run_worker
 
     if args.study is None:
@@ -72,6 +74,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     settings = SweepSettings(study=args.study, overrides=tuple(args.overrides), **values)
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    if args.enqueue_base:  # before any worker draws a trial
+        space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
+        inside, outside = enqueue_base(open_study(settings)[0], settings, space)
+        print(f"enqueued the base config as the first trial: {inside}"
+              + (f"; outside the space, drawn instead: {outside}" if outside else ""), file=sys.stderr)  # fmt: skip
     if args.workers > 1:
         load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)  # before creating
         study, storage = open_study(settings)  # create it once, so the workers only join

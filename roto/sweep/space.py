@@ -63,6 +63,14 @@ class Parameter:
         """The values a run must accept for every draw to be usable: the bounds, or every choice."""
         return [self.low, self.high] if self.type != "categorical" else list(self.choices)
 
+    def contains(self, value: Any) -> bool:
+        """Whether this parameter's distribution can draw ``value``."""
+        if self.type == "categorical":
+            return value in self.choices
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not self.low <= value <= self.high:
+            return False
+        return self.type == "float" or (float(value).is_integer() and (value - self.low) % self.step == 0)
+
 
 @dataclass(frozen=True)
 class SearchSpace:
@@ -74,6 +82,20 @@ class SearchSpace:
     def suggest(self, trial: optuna.Trial) -> dict[str, Any]:
         """{override key: value} drawn for ``trial``."""
         return {p.key: p.suggest(trial) for p in self.parameters}
+
+
+def base_values(space: SearchSpace, env: EnvConfig, agent: AgentConfig) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The base run's value of every searched parameter, split into those its distribution can draw
+    and those outside it: ({key: value} inside, {key: value} outside)."""
+    tree = {"env": dataclasses.asdict(env), **dataclasses.asdict(agent)}
+    inside, outside = {}, {}
+    for parameter in space.parameters:
+        value: Any = tree
+        for part in parameter.key.split("."):
+            value = value[part]
+        value = list(value) if isinstance(value, tuple) else value
+        (inside if parameter.contains(value) else outside)[parameter.key] = value
+    return inside, outside
 
 
 def as_overrides(params: dict[str, Any]) -> list[str]:

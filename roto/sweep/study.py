@@ -127,6 +127,27 @@ def open_study(settings: SweepSettings) -> tuple[optuna.Study, optuna.storages.B
     return study, storage
 
 
+def enqueue_base(study: optuna.Study, settings: SweepSettings, space: Any) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Enqueue the base run (the study's agent config and fixed overrides) as the study's first
+    trial: each searched parameter at the base's value where its distribution can draw it, drawn
+    as usual where not. Only into a study without trials (ValueError otherwise); returns
+    (the enqueued values, the base values outside the space)."""
+    from roto.rl.config import load_agent_config
+    from roto.rl.overrides import apply_env_overrides, split_overrides
+    from roto.sweep.space import base_values
+
+    if study.trials:
+        raise ValueError(
+            f"--enqueue_base: study {settings.study!r} already has {len(study.trials)} trials; the base run is "
+            "enqueued only as a new study's first trial"
+        )
+    env_changes, agent_overrides = split_overrides(list(settings.overrides))
+    env = apply_env_overrides(settings.base_env(), env_changes)
+    inside, outside = base_values(space, env, load_agent_config(settings.task, settings.agent_cfg, agent_overrides))
+    study.enqueue_trial(inside)
+    return inside, outside
+
+
 def check_study_name(name: str) -> None:
     """Refuse a study name that is not a plain name (it names a folder under ``--root``)."""
     if not isinstance(name, str) or not STUDY_NAME.fullmatch(name) or set(name) == {"."}:

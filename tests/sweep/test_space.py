@@ -95,3 +95,14 @@ def test_an_exported_config_names_a_file_base_relative_to_itself(tmp_path):
     assert changed_keys({"ppo": {"lr": 1, "gamma": 2}, "ssl": {}}, {"ppo": {"lr": 3, "gamma": 2}, "ssl": {}}) == {
         "ppo": {"lr": 3}
     }
+
+
+def test_a_parameter_contains_exactly_the_values_its_distribution_can_draw():
+    from roto.sweep.space import Parameter
+
+    epochs = Parameter("ppo.epochs", "int", low=2, high=8, step=2)
+    assert epochs.contains(4) and not epochs.contains(3) and not epochs.contains(10) and not epochs.contains(True)
+    lr = Parameter("ppo.lr", "float", low=1e-5, high=1e-3, log=True)
+    assert lr.contains(2.59e-4) and not lr.contains(2e-3)
+    rollouts = Parameter("ppo.rollouts", "categorical", choices=(16, 32))
+    assert rollouts.contains(32) and not rollouts.contains(64)

@@ -177,6 +177,26 @@ def test_a_study_stored_before_objectives_existed_is_joined_as_a_return_study(tm
         open_study(toy_settings(tmp_path, trials=2, objective="metric"))
 
 
+def test_the_base_config_is_enqueued_as_the_first_trial_where_the_space_can_draw_it(tmp_path):
+    from roto.sweep.space import load_space
+    from roto.sweep.study import enqueue_base
+
+    torch.set_num_threads(1)
+    settings = toy_settings(tmp_path, trials=2, overrides=(*TOY_OVERRIDES, "env.action_smoothing=0.5"))
+    study, _ = open_study(settings)
+    space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
+    inside, outside = enqueue_base(study, settings, space)
+    base = load_agent_config("bounce")
+    assert inside == {"ppo.lr": base.ppo.lr, "env.action_smoothing": 0.5}  # the study's fixed override counts
+    assert outside == {"ppo.epochs": 17}  # roto's 17 epochs: outside the toy space's 1-3, drawn instead
+    assert run_worker(settings, env_factory=ToyEnv) == 2
+    first = finished_trials(settings)[0].trials[0]
+    assert first.params["ppo.lr"] == base.ppo.lr and first.params["env.action_smoothing"] == 0.5
+    assert 1 <= first.params["ppo.epochs"] <= 3
+    with pytest.raises(ValueError, match=r"already has 2 trials; the base run is enqueued only as a new study"):
+        enqueue_base(study, settings, space)
+
+
 def test_joining_a_study_with_other_settings_is_an_error(tmp_path):
     open_study(toy_settings(tmp_path, trials=4))
     with pytest.raises(ValueError, match=r"exists with other settings.*'steps': \(192, 320\)"):
