@@ -14,7 +14,7 @@ from roto.rl.config import load_agent_config, packaged_configs, to_dict
 from roto.rl.overrides import split_overrides
 from roto.sweep.space import as_overrides
 from roto.sweep.storage import REASON_ATTR, RETRY_OF_ATTR
-from roto.sweep.study import load_existing_study
+from roto.sweep.study import SETTINGS_ATTR, load_existing_study
 
 
 def export_best(
@@ -86,10 +86,12 @@ def trials_table(study: optuna.Study) -> str:
     report, its wall minutes (of its last attempt), parameters, why it ended."""
     trials = study.get_trials(deepcopy=False)
     keys = sorted({k for t in trials for k in t.params})
-    head = ["trial", "state", "best eval return", "seed", "env steps", "minutes", *keys, "reason"]
+    settings = study.user_attrs.get(SETTINGS_ATTR, {})
+    by_metric = _objective_name(settings) != "return"  # the metric's steps are small: more digits
+    head = ["trial", "state", f"best eval {_objective_name(settings)}", "seed", "env steps", "minutes", *keys, "reason"]
     rows = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for t in trials:
-        value = f"{t.value:.3f}" if t.value is not None else ""
+        value = (f"{t.value:.6f}" if by_metric else f"{t.value:.3f}") if t.value is not None else ""
         steps = str(max(t.intermediate_values)) if t.intermediate_values else ""
         params = [_short(t.params[k]) if k in t.params else "" for k in keys]
         cells = [str(t.number), t.state.name.lower(), value, str(t.user_attrs.get("seed", "")), steps, _minutes(t)]

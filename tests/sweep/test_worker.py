@@ -159,6 +159,10 @@ def test_a_metric_objective_ranks_trials_by_the_headline_metric_with_the_return_
         records = read_evaluations(run_dir_of(settings, trial.number))
         values = [r["hits_mean"] + 1e-6 * r["return_mean"] for r in records]
         assert trial.value == max(values) and trial.intermediate_values[records[-1]["env_steps"]] == max(values)
+    from roto.sweep.report import trials_table
+
+    table = trials_table(finished_trials(settings)[0])
+    assert "| best eval headline metric (+1e-6 x return) |" in table and f"| {trial.value:.6f} |" in table
     with pytest.raises(ValueError, match=r"'objective': \('metric', 'return'\)"):
         open_study(toy_settings(tmp_path, trials=2))  # the stored objective is part of the study
     with pytest.raises(ValueError, match=r"unknown objective 'rotations'; valid objectives: \['return', 'metric'\]"):
