@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import pathlib
 import random
 import re
@@ -86,11 +85,6 @@ class SweepSettings:
         data = {k: getattr(self, k) for k in keep}
         data["overrides"] = list(self.overrides)
         return data
-
-    def with_identity(self, identity: dict[str, Any]) -> SweepSettings:
-        """These settings with the study-defining ones taken from ``identity``."""
-        identity = {**IDENTITY_DEFAULTS, **identity}
-        return dataclasses.replace(self, **{**identity, "overrides": tuple(identity["overrides"])})
 
 
 def trial_seed(study: str, number: int) -> int:
