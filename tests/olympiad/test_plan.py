@@ -108,10 +108,18 @@ def test_robot_in_an_override_becomes_each_cells_hand():
     from roto.olympiad.plan import Cell
 
     plan = load_plan("baoding_v1_cpu")
-    for robot in ("shadow", "orca"):
-        spec = cell_spec(plan, Cell("baoding", robot, "blind", "task_critic_replay", 1))
+    for robot, variant, share in (("shadow", "task_critic_replay", 0.25), ("orca", "task_critic_more_aids", 0.5)):
+        spec = cell_spec(plan, Cell("baoding", robot, "blind", variant, 1))
         assert spec.env.replay_starts == f"benchmarks/results/baoding_reference/{robot}_preswap.npz"
-        assert spec.env.replay_share == 0.25 and spec.agent.ppo.epochs == 4 and spec.env.threads == 2
+        assert spec.env.replay_share == share and spec.agent.ppo.epochs == 4 and spec.env.threads == 2
+    assert {(c.robot, c.variant) for c in plan.cells} == {
+        ("shadow", "task_critic_replay"),
+        *((robot, "task_critic_more_aids") for robot in ("shadow_lite", "allegro", "orca")),
+    }
+    lite = cell_spec(plan, Cell("baoding", "shadow_lite", "blind", "task_critic_more_aids", 0))
+    more_aids = load_plan("baoding_v1_more_aids")
+    same = cell_spec(more_aids, next(c for c in more_aids.cells if c.variant == "all_three"))
+    assert lite.differences(same) == {}  # the all_three run continues as this plan's cell
     assert all(
         pathlib.Path(f"benchmarks/results/baoding_reference/{c.robot}_preswap.npz").is_file() for c in plan.cells
     )
