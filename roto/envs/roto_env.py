@@ -133,6 +133,8 @@ class RotoEnv:
         self._since_check = 0
         frame = self._reset_where(torch.ones(self.num_envs, dtype=torch.bool, device=self.device))
         self._stack.reset(frame)
+        if self.recorder is not None:  # every episode starts over: no metric to rise from
+            self.recorder.last_metric.zero_()
         self._needs_reset = False
         return self._stack.observation(), {}
 

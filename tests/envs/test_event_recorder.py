@@ -199,3 +199,12 @@ def test_recording_needs_replayed_starts_and_evaluation_never_records():
         EnvConfig(task="baoding", replay_record_capacity=0)
     config = EnvConfig(task="bounce", replay_starts="bank.npz", replay_share=0.5, replay_record_lead=10)
     assert TrainSettings(env=config).eval_env_config(4).replay_record_lead == 0
+
+
+def test_a_reset_mid_run_starts_every_metric_over(tmp_path):
+    env = recording_env(own_bank(tmp_path / "bank.npz"))
+    play(env, 80)
+    assert env.recorder.last_metric.any()  # some episode has bounced
+    env.reset()
+    assert not env.recorder.last_metric.any()
+    env.close()
