@@ -136,12 +136,11 @@ def event_recorder_for(env: RotoEnv) -> EventRecorder | None:
     return EventRecorder.empty(config.replay_record_lead, config.replay_record_capacity, like)
 
 
-def record_events(env: RotoEnv, sim: SimState, done: torch.Tensor) -> None:
-    """Give ``env.recorder`` this control step: the state after it, the task's headline metric and
-    the episodes' lengths, before the worlds where ``done`` (B,) reset."""
+def record_events(env: RotoEnv, sim: SimState, metric: torch.Tensor, done: torch.Tensor) -> None:
+    """Give ``env.recorder`` this control step: the state after it, the task's headline ``metric``
+    (B,) and the episodes' lengths, before the worlds where ``done`` (B,) reset."""
     rows = {"qpos": sim.qpos, "qvel": sim.qvel, "target": env._target}
     rows.update({f"task/{name}": getattr(env.task_state, name) for name in env.replay_bank.task})
-    metric = env.task.metrics(env.task_state)[env.task.headline_metric]
     env.recorder.observe(rows, metric, env._episode.length, done)
 
 

@@ -70,8 +70,7 @@ def tolerance_curriculum_for(env: RotoEnv) -> ToleranceCurriculum | None:
     return curriculum
 
 
-def update_tolerance(env: RotoEnv, done: torch.Tensor) -> None:
-    """This step's ended episodes into ``env.curriculum``, before their task state resets; the
-    task's radius follows."""
-    metric = env.task.metrics(env.task_state)[env.task.headline_metric]
+def update_tolerance(env: RotoEnv, metric: torch.Tensor, done: torch.Tensor) -> None:
+    """This step's ended episodes (``done`` (B,), their headline ``metric`` (B,)) into
+    ``env.curriculum``, before their task state resets; the task's radius follows."""
     env.task_state.radius.copy_(env.curriculum.update(metric, done))

@@ -211,7 +211,7 @@ class Trainer:
             t_sim += t2 - t1
         scalars = {"perf/inference_s": t_inference, "perf/simulation_s": t_sim}
         if getattr(self.env, "curriculum", None) is not None:  # a training aid's state, read once per update
-            scalars["train/success_radius"] = float(self.env.task_state.radius)
+            scalars["train/success_radius"] = float(self.env.curriculum.radius())
         return scalars
 
     def _evaluate(self) -> dict[str, float]:

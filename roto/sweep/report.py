@@ -14,7 +14,7 @@ from roto.rl.config import load_agent_config, packaged_configs, to_dict
 from roto.rl.overrides import split_overrides
 from roto.sweep.space import as_overrides
 from roto.sweep.storage import REASON_ATTR, RETRY_OF_ATTR
-from roto.sweep.study import SETTINGS_ATTR, load_existing_study
+from roto.sweep.study import SETTINGS_ATTR, TIE_BREAK, load_existing_study
 
 
 def export_best(
@@ -151,4 +151,4 @@ def _objective_name(settings: dict) -> str:
     """What a study's trial values are (its stored objective; studies stored before it: the return)."""
     if settings.get("objective", "return") == "return":
         return "return"
-    return "headline metric (+1e-6 x return)"
+    return f"headline metric (+{TIE_BREAK:g} x return)"

@@ -22,6 +22,10 @@ SETTINGS_ATTR = "roto:settings"
 OBJECTIVES = ("return", "metric")
 """What trials maximise: the best evaluation's mean return, or the task's headline metric with the
 return breaking ties (``roto.sweep.trial.objective_value``)."""
+TIE_BREAK = 1e-6
+"""The weight of the mean return in the ``metric`` objective: below the smallest step of a mean
+over 100 episodes of a counted metric (0.5 / 100 rotations) for returns up to 5000."""
+
 IDENTITY_DEFAULTS = {"objective": "return"}
 """Identity fields added since studies were first stored: a stored study without one had this."""
 

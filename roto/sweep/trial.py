@@ -27,11 +27,7 @@ from roto.rl.run_spec import RunSpec, build_run_spec
 from roto.rl.runner import Trainer
 from roto.sweep.space import SearchSpace, as_overrides
 from roto.sweep.storage import RETRY_OF_ATTR
-from roto.sweep.study import SweepSettings, trial_seed
-
-TIE_BREAK = 1e-6
-"""The weight of the mean return in the ``metric`` objective: below the smallest step of a mean
-over 100 episodes of a counted metric (0.5 / 100 rotations) for returns up to 5000."""
+from roto.sweep.study import TIE_BREAK, SweepSettings, trial_seed
 
 
 def objective_value(record: dict[str, float], objective: str, headline_metric: str) -> float:

@@ -162,7 +162,7 @@ def test_a_metric_objective_ranks_trials_by_the_headline_metric_with_the_return_
     from roto.sweep.report import trials_table
 
     table = trials_table(finished_trials(settings)[0])
-    assert "| best eval headline metric (+1e-6 x return) |" in table and f"| {trial.value:.6f} |" in table
+    assert "| best eval headline metric (+1e-06 x return) |" in table and f"| {trial.value:.6f} |" in table
     with pytest.raises(ValueError, match=r"'objective': \('metric', 'return'\)"):
         open_study(toy_settings(tmp_path, trials=2))  # the stored objective is part of the study
     with pytest.raises(ValueError, match=r"unknown objective 'rotations'; valid objectives: \['return', 'metric'\]"):
