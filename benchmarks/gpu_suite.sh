@@ -7,8 +7,8 @@
 #   pytest_gpu.txt    `pytest -m gpu`: every pair stepped and a short training under sync-debug "error"
 #   bench_warp.jsonl  `roto bench` of all 8 (task, robot) pairs at NUM_ENVS (default 8192)
 #   scaling.jsonl     Shadow Bounce at 1k, 4k, 8k, 16k and 32k envs
-#   update_cost.jsonl one PPO update of blind Shadow Bounce at NUM_ENVS: eager, CUDA graph, each with
-#                     and without TF32 (benchmarks/update_cost.py)
+#   update_cost.jsonl one PPO update of blind Shadow Bounce at NUM_ENVS: eager, CUDA graph, fused
+#                     Adam, TF32 and mixes of them (benchmarks/update_cost.py)
 #   train_bounce_shadow/  if TRAIN_SECONDS > 0: blind Shadow Bounce at NUM_ENVS, stopped after that many
 #                     seconds (scalars.csv: perf/steps_per_s; evaluations.jsonl: the evaluation curve),
 #                     with policy_best.pt / policy_latest.pt (weights and settings only, for `roto eval`

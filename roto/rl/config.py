@@ -93,6 +93,12 @@ class PPOConfig:
     cuda_graph: bool = False
     """Replay each minibatch step from a CUDA graph (roto/rl/graphed_step.py): the same update with
     far fewer kernel launches. CUDA devices only, without auxiliary losses."""
+    fused_adam: bool = False
+    """Step Adam with PyTorch's fused implementation (a few kernels for all parameters instead of
+    several per parameter): the same update up to rounding, fewer launches on a GPU."""
+    tf32_update: bool = False
+    """Let the update's matrix products on a CUDA device use TF32 (10-bit mantissa inputs, FP32
+    accumulation; torch.backends.cuda.matmul.allow_tf32) for its duration. No effect on a CPU."""
 
 
 @dataclass(frozen=True, kw_only=True)

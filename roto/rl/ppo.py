@@ -8,6 +8,8 @@ as ``loss/<name>``.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from typing import Any
 
 import torch
@@ -46,6 +48,17 @@ def check_graphable(config: PPOConfig, storage: RolloutBuffer, aux_losses: list[
         raise ValueError(f"ppo.cuda_graph=true needs the envs on a CUDA device, got device={str(device)!r}")
 
 
+@contextlib.contextmanager
+def tf32_matmuls(enabled: bool) -> Iterator[None]:
+    """Within: CUDA matrix products may use TF32 if ``enabled`` (or if they already could)."""
+    saved = torch.backends.cuda.matmul.allow_tf32
+    torch.backends.cuda.matmul.allow_tf32 = saved or enabled
+    try:
+        yield
+    finally:
+        torch.backends.cuda.matmul.allow_tf32 = saved
+
+
 class PPO:
     """The learner: actor-critic, Adam, value-target scaler, KL-adaptive lr and auxiliary losses.
 
@@ -69,14 +82,15 @@ class PPO:
         self.aux_losses = list(aux_losses or [])
         self.lr = config.lr
         self._graphed: GraphedMinibatchStep | None = None
+        fused = True if config.fused_adam else None  # None: PyTorch picks its default implementation
         if config.cuda_graph:
             check_graphable(config, storage, self.aux_losses)
             # a KL-adaptive lr must be a device tensor the graph reads, changed in place
             lr = torch.tensor(config.lr, device=storage.values.device) if config.kl_adaptive else config.lr
-            self.optimizer = torch.optim.Adam(model.parameters(), lr=lr, capturable=True)
+            self.optimizer = torch.optim.Adam(model.parameters(), lr=lr, capturable=True, fused=fused)
             self._graphed = GraphedMinibatchStep(lambda batch: self._minibatch_step(batch, []), model, self.optimizer)
         else:
-            self.optimizer = torch.optim.Adam(model.parameters(), lr=config.lr)
+            self.optimizer = torch.optim.Adam(model.parameters(), lr=config.lr, fused=fused)
         self.value_scaler = None
         if config.value_normalization:
             self.value_scaler = RunningStandardScaler(1, clip=None).to(storage.values.device)
@@ -143,6 +157,10 @@ class PPO:
         Returns the mean of each loss term (``loss/<name>``), auxiliary metrics
         (``<loss>/<metric>``) and PPO diagnostics (``ppo/<name>``).
         """
+        with tf32_matmuls(self.config.tf32_update):
+            return self._update()
+
+    def _update(self) -> dict[str, float]:
         c, buffer = self.config, self.storage
         aux_batches = {aux.name: aux.prepare(buffer, c.minibatches, self.generator) for aux in self.aux_losses}
         sums: dict[str, torch.Tensor] = {}

@@ -97,7 +97,7 @@ def test_max_log_std_bounds_the_policy_std():
     with torch.no_grad():
         model.log_std.fill_(1.5)  # as a growing entropy bonus would push it
     _, log_std, _, _ = model({"tactile": torch.zeros(2, 4), "proprio": torch.zeros(2, 8)})
-    assert torch.equal(log_std, torch.zeros(3)) and math.isclose(float(model.clamped_log_std().exp()[0]), 1.0)
+    assert torch.equal(log_std, torch.zeros(3)) and math.isclose(float(model.clamped_log_std().detach().exp()[0]), 1.0)
     roto_default = build_model({"tactile": 4, "proprio": 8}, 3, load_agent_config("bounce"), "blind")
     assert roto_default.max_log_std == 2.0
     with pytest.raises(ValueError, match=r"network.max_log_std must be above -20.0, got -30"):

@@ -1,5 +1,6 @@
-"""``ppo.cuda_graph``: the graphed update trains as the eager one does (on a GPU), and a setting it
-cannot run is refused before any training (everywhere)."""
+"""The update's speed-ups: ``ppo.cuda_graph`` (the graphed update trains as the eager one does, on a
+GPU; a setting it cannot run is refused before any training, everywhere) and ``ppo.fused_adam``
+(the same update as PyTorch's default Adam, on the CPU and graphed on a GPU)."""
 
 import pytest
 import torch
@@ -58,12 +59,30 @@ def test_inputs_are_copied_in_place_and_a_changed_shape_is_refused():
         copy_tree(inputs, {"obs": {"proprio": torch.ones(4, 2)}, "actions": torch.ones(3, 1)})
 
 
+def test_fused_adam_trains_as_the_default_adam():
+    device = torch.device("cpu")
+    plain, fused = learner(device, ["ppo.lr=1e-3"]), learner(device, ["ppo.lr=1e-3", "ppo.fused_adam=true"])
+    assert fused.optimizer.defaults["fused"] and not plain.optimizer.defaults["fused"]
+    start = [p.detach().clone() for p in plain.model.parameters()]
+    for seed in range(3):
+        fill(plain, device, seed)
+        fill(fused, device, seed)
+        plain_out, fused_out = plain.update(), fused.update()
+        for name, value in plain_out.items():
+            assert fused_out[name] == pytest.approx(value, rel=1e-4, abs=1e-6), name
+    for a, b in zip(plain.model.parameters(), fused.model.parameters(), strict=True):
+        torch.testing.assert_close(b, a, rtol=1e-4, atol=1e-6)
+    moved = [not torch.equal(p, q) for p, q in zip(plain.model.parameters(), start, strict=True)]
+    assert sum(moved) > len(moved) // 2  # the updates trained: equal weights are not two idle optimisers
+
+
 @pytest.mark.gpu
 @needs_cuda
-@pytest.mark.parametrize("kl_adaptive", [False, True])
-def test_graphed_updates_train_as_eager_ones(kl_adaptive):
+@pytest.mark.parametrize(("kl_adaptive", "fused"), [(False, False), (True, False), (True, True)])
+def test_graphed_updates_train_as_eager_ones(kl_adaptive, fused):
     device = torch.device("cuda")
     flags = [f"ppo.kl_adaptive={str(kl_adaptive).lower()}", "ppo.lr=1e-3", "ppo.cuda_graph=true"]
+    flags.append(f"ppo.fused_adam={str(fused).lower()}")
     eager, graphed = learner(device, flags), learner(device, flags)
     eager._graphed = None  # the same capturable Adam and lr tensor, stepped eagerly: the reference
     for seed in range(3):  # the first update captures, the later ones replay
@@ -93,3 +112,20 @@ def test_graphed_minibatch_steps_never_wait_for_the_device():
     finally:
         torch.cuda.set_sync_debug_mode(0)
     assert all(torch.isfinite(p).all() for p in alg.model.parameters())
+
+
+@pytest.mark.parametrize("enabled", [False, True])
+def test_tf32_update_allows_tf32_only_during_the_update(enabled, monkeypatch):
+    alg = learner(torch.device("cpu"), [f"ppo.tf32_update={str(enabled).lower()}"])
+    seen, step = [], alg._minibatch_step
+
+    def recording_step(*args):
+        seen.append(torch.backends.cuda.matmul.allow_tf32)
+        return step(*args)
+
+    monkeypatch.setattr(alg, "_minibatch_step", recording_step)
+    fill(alg, torch.device("cpu"), 0)
+    assert not torch.backends.cuda.matmul.allow_tf32
+    alg.update()
+    assert seen and set(seen) == {enabled}
+    assert not torch.backends.cuda.matmul.allow_tf32  # restored after the update
