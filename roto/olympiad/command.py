@@ -87,7 +87,7 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
         hours = left * plan.steps / rate / 3600
         estimate = f"{hours:.1f} h for one worker at {rate:.0f} env steps/s (the finished cells' throughput)"
     else:
-        estimate = "unknown until a cell has finished (no throughput measured yet)"
+        estimate = f"unknown: no finished cell's summary in {results} (--results names the folder)"
     lines += ["", f"{len(status) - left} done, {left} left; time left: {estimate}"]
     return "\n".join(lines)
 

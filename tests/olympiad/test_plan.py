@@ -85,6 +85,8 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     # 15 cells left x 5 M steps at 5000 env steps/s = 15000 s
     assert "1 done, 15 left; time left: 4.2 h for one worker at 5000 env steps/s" in out
     assert not (tmp_path / "cpu").exists()  # a dry run creates no study
+    assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
+    assert f"time left: unknown: no finished cell's summary in {tmp_path / 'none'}" in capsys.readouterr().out
 
 
 def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():
