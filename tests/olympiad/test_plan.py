@@ -2,7 +2,7 @@ import pathlib
 
 import pytest
 
-from roto.olympiad.plan import load_plan, packaged_plans
+from roto.olympiad.plan import Cell, load_plan, packaged_plans
 
 
 def test_packaged_plans():
@@ -91,7 +91,6 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
 
 def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():
     from roto.olympiad.cell import cell_spec
-    from roto.olympiad.plan import Cell
 
     plan = load_plan("variants_bounce")
     force = cell_spec(plan, Cell("bounce", "shadow", "blind", "force_touch", 1))
@@ -107,7 +106,6 @@ def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agent
 
 def test_robot_in_an_override_becomes_each_cells_hand():
     from roto.olympiad.cell import cell_spec
-    from roto.olympiad.plan import Cell
 
     plan = load_plan("baoding_v1_cpu")
     for robot, variant, share in (("shadow", "task_critic_replay", 0.25), ("orca", "task_critic_more_aids", 0.5)):
@@ -129,7 +127,6 @@ def test_robot_in_an_override_becomes_each_cells_hand():
 
 def test_robot_in_an_agent_config_names_a_config_per_hand_and_a_missing_one_is_refused(tmp_path):
     from roto.olympiad.cell import cell_spec
-    from roto.olympiad.plan import Cell
 
     for robot, lr in (("shadow", 1.0e-4), ("allegro", 3.0e-4)):
         (tmp_path / f"tuned_{robot}.yaml").write_text(f"extends: bounce_cpu_quickstart\nppo:\n  lr: {lr}\n")
@@ -154,8 +151,8 @@ def test_the_more_aids_plan_adds_each_aid_to_the_recipe_for_shadow_lite():
     from roto.olympiad.cell import cell_spec
 
     plan = load_plan("baoding_v1_more_aids")
-    specs = {c.variant: cell_spec(plan, c) for c in plan.cells}
-    assert {c.robot for c in plan.cells} == {"shadow_lite"} and len(specs) == 4
+    specs = {c.variant: cell_spec(plan, c) for c in plan.cells if c.robot == "shadow_lite"}
+    assert len(specs) == 4
     assert all(
         s.env.replay_starts.endswith("shadow_lite_preswap.npz") and s.agent.ppo.epochs == 4 for s in specs.values()
     )
@@ -166,3 +163,14 @@ def test_the_more_aids_plan_adds_each_aid_to_the_recipe_for_shadow_lite():
     assert (
         everything.replay_share == 0.5 and everything.tolerance_start == 0.025 and everything.replay_record_lead == 10
     )
+
+
+@pytest.mark.parametrize("robot", ["allegro", "orca"])
+def test_the_more_aids_probe_of_a_hand_trains_as_its_20m_cell_does(robot):
+    """The 5 M probe's run continues as the baoding_v1_cpu cell: nothing but the budget differs."""
+    from roto.olympiad.cell import cell_spec
+
+    probe = cell_spec(load_plan("baoding_v1_more_aids"), Cell("baoding", robot, "blind", "all_three", 0))
+    cell = cell_spec(load_plan("baoding_v1_cpu"), Cell("baoding", robot, "blind", "task_critic_more_aids", 0))
+    assert probe.differences(cell) == {} and probe.env.replay_starts.endswith(f"{robot}_preswap.npz")
+    assert (probe.steps, cell.steps) == (5_000_000, 20_000_000)
