@@ -13,18 +13,38 @@ from roto.registry import make
 
 
 def run_hold(
-    task: str = "baoding", robot: str = "shadow", num_envs: int = 64, seed: int = 0, backend: str = "cpu"
+    task: str = "baoding",
+    robot: str = "shadow",
+    num_envs: int = 64,
+    seed: int = 0,
+    backend: str = "cpu",
+    action_noise: float = 0.0,
 ) -> dict[str, float]:
-    """One episode per env of the hold policy from the env's own starts; its return and metrics."""
+    """One episode per env of the hold policy from the env's own starts; its return and metrics.
+
+    ``action_noise`` > 0 adds independent N(0, action_noise²) noise to every action of every step
+    (actions in [-1, 1] span each joint's range): how much of a fresh policy's exploration noise
+    the hand tolerates before it drops the balls.
+    """
+    if action_noise < 0:
+        raise ValueError(f"action_noise must be >= 0, got {action_noise}")
     env = make(task, robot=robot, num_envs=num_envs, seed=seed, backend=backend)
     hold = env.hold_action().expand(num_envs, -1).contiguous()
+    noise = torch.Generator().manual_seed(seed)
+
+    def policy(_obs: object) -> torch.Tensor:
+        if action_noise == 0:
+            return hold
+        return hold + action_noise * torch.randn(hold.shape, generator=noise, dtype=hold.dtype)
+
     obs, _ = env.reset()
-    result = first_episodes(env, lambda _obs: hold, obs)
+    result = first_episodes(env, policy, obs)
     env.close()
     stats = {
         "task": env.task.name,
         "robot": env.robot.name,
         "episodes": num_envs,
+        "action_noise": action_noise,
         "mean_return": float(result["return"].mean()),
         "std_return": float(result["return"].std()),
         "mean_length": float(result["length"].mean()),

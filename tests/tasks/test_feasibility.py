@@ -47,6 +47,17 @@ def test_the_hold_pose_catches_the_dropped_baoding_balls_and_never_swaps(name):
     assert stats["mean_swaps"] == 0.0, stats
 
 
+def test_exploration_noise_on_the_hold_pose_drops_the_balls_and_a_negative_std_is_refused():
+    """Noise of a fresh policy's std (1) on every action: ORCA loses the balls within about half a
+    second (32 control steps on average over 64 episodes, benchmarks/results/baoding_reference/
+    hold_noise.json); the noise is seeded, so the same call repeats exactly."""
+    noisy = run_hold("baoding", "orca", num_envs=8, seed=0, action_noise=1.0)
+    assert noisy["action_noise"] == 1.0 and noisy["mean_length"] < 100 and noisy["full_length_share"] == 0.0
+    assert run_hold("baoding", "orca", num_envs=8, seed=0, action_noise=1.0) == noisy
+    with pytest.raises(ValueError, match=r"action_noise must be >= 0, got -0.1"):
+        run_hold("baoding", "orca", action_noise=-0.1)
+
+
 # Issue thresholds: the Shadow >= 10 bounces per 10 s episode, every other hand >= 5.
 SCRIPTED_MINIMUM = {"shadow": 10.0, "shadow_lite": 5.0, "allegro": 5.0, "orca": 5.0}
 
