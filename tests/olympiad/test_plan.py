@@ -174,3 +174,15 @@ def test_the_more_aids_probe_of_a_hand_trains_as_its_20m_cell_does(robot):
     cell = cell_spec(load_plan("baoding_v1_cpu"), Cell("baoding", robot, "blind", "task_critic_more_aids", 0))
     assert probe.differences(cell) == {} and probe.env.replay_starts.endswith(f"{robot}_preswap.npz")
     assert (probe.steps, cell.steps) == (5_000_000, 20_000_000)
+
+
+def test_the_low_noise_variant_differs_from_all_three_only_in_the_policy_std():
+    from roto.olympiad.cell import cell_spec
+
+    plan = load_plan("baoding_v1_more_aids")
+    low = cell_spec(plan, Cell("baoding", "orca", "blind", "all_three_low_noise", 0))
+    usual = cell_spec(plan, Cell("baoding", "orca", "blind", "all_three", 0))
+    assert low.differences(usual) == {
+        "agent.network.init_log_std": (-1.386, 0.0),
+        "agent.network.max_log_std": (-1.386, 2.0),
+    }
