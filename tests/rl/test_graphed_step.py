@@ -34,6 +34,19 @@ def fill(alg, device, seed):
     alg.compute_returns({g: torch.randn(NUM_ENVS, d, generator=data).to(device) for g, d in SIZES.items()})
 
 
+def assert_trains_alike(reference, other, device, rel, abs_, updates=3):
+    """Both learners, fed the same rollouts, report the same metrics and hold the same weights after
+    every update (within rel/abs_)."""
+    for seed in range(updates):
+        fill(reference, device, seed)
+        fill(other, device, seed)
+        reference_out, other_out = reference.update(), other.update()
+        for name, value in reference_out.items():
+            assert other_out[name] == pytest.approx(value, rel=rel, abs=abs_), name
+        for a, b in zip(reference.model.parameters(), other.model.parameters(), strict=True):
+            torch.testing.assert_close(b, a, rtol=rel, atol=abs_)
+
+
 @pytest.mark.parametrize(
     ("overrides", "message"),
     [
@@ -64,14 +77,7 @@ def test_fused_adam_trains_as_the_default_adam():
     plain, fused = learner(device, ["ppo.lr=1e-3"]), learner(device, ["ppo.lr=1e-3", "ppo.fused_adam=true"])
     assert fused.optimizer.defaults["fused"] and not plain.optimizer.defaults["fused"]
     start = [p.detach().clone() for p in plain.model.parameters()]
-    for seed in range(3):
-        fill(plain, device, seed)
-        fill(fused, device, seed)
-        plain_out, fused_out = plain.update(), fused.update()
-        for name, value in plain_out.items():
-            assert fused_out[name] == pytest.approx(value, rel=1e-4, abs=1e-6), name
-    for a, b in zip(plain.model.parameters(), fused.model.parameters(), strict=True):
-        torch.testing.assert_close(b, a, rtol=1e-4, atol=1e-6)
+    assert_trains_alike(plain, fused, device, rel=1e-4, abs_=1e-6)
     moved = [not torch.equal(p, q) for p, q in zip(plain.model.parameters(), start, strict=True)]
     assert sum(moved) > len(moved) // 2  # the updates trained: equal weights are not two idle optimisers
 
@@ -85,14 +91,7 @@ def test_graphed_updates_train_as_eager_ones(kl_adaptive, fused):
     flags.append(f"ppo.fused_adam={str(fused).lower()}")
     eager, graphed = learner(device, flags), learner(device, flags)
     eager._graphed = None  # the same capturable Adam and lr tensor, stepped eagerly: the reference
-    for seed in range(3):  # the first update captures, the later ones replay
-        fill(eager, device, seed)
-        fill(graphed, device, seed)
-        eager_out, graphed_out = eager.update(), graphed.update()
-        for name, value in eager_out.items():
-            assert graphed_out[name] == pytest.approx(value, rel=1e-5, abs=1e-7), name
-        for a, b in zip(eager.model.parameters(), graphed.model.parameters(), strict=True):
-            torch.testing.assert_close(b, a, rtol=1e-5, atol=1e-7)
+    assert_trains_alike(eager, graphed, device, rel=1e-5, abs_=1e-7)  # the first update captures
     assert graphed.lr == pytest.approx(eager.lr)
 
 
