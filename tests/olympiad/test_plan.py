@@ -108,13 +108,15 @@ def test_robot_in_an_override_becomes_each_cells_hand():
     from roto.olympiad.cell import cell_spec
 
     plan = load_plan("baoding_v1_cpu")
-    for robot, variant, share in (("shadow", "task_critic_replay", 0.25), ("orca", "task_critic_more_aids", 0.5)):
+    cells = (("shadow", "task_critic_replay", 0.25), ("orca", "task_critic_more_aids_low_noise", 0.5))
+    for robot, variant, share in cells:
         spec = cell_spec(plan, Cell("baoding", robot, "blind", variant, 1))
         assert spec.env.replay_starts == f"benchmarks/results/baoding_reference/{robot}_preswap.npz"
         assert spec.env.replay_share == share and spec.agent.ppo.epochs == 4 and spec.env.threads == 2
     assert {(c.robot, c.variant) for c in plan.cells} == {
         ("shadow", "task_critic_replay"),
-        *((robot, "task_critic_more_aids") for robot in ("shadow_lite", "allegro", "orca")),
+        *((robot, "task_critic_more_aids") for robot in ("shadow_lite", "allegro")),
+        ("orca", "task_critic_more_aids_low_noise"),
     }
     lite = cell_spec(plan, Cell("baoding", "shadow_lite", "blind", "task_critic_more_aids", 0))
     more_aids = load_plan("baoding_v1_more_aids")
@@ -165,13 +167,19 @@ def test_the_more_aids_plan_adds_each_aid_to_the_recipe_for_shadow_lite():
     )
 
 
-@pytest.mark.parametrize("robot", ["allegro", "orca"])
-def test_the_more_aids_probe_of_a_hand_trains_as_its_20m_cell_does(robot):
+@pytest.mark.parametrize(
+    ("robot", "probe_variant", "cell_variant"),
+    [
+        ("allegro", "all_three", "task_critic_more_aids"),
+        ("orca", "all_three_low_noise", "task_critic_more_aids_low_noise"),
+    ],
+)
+def test_the_more_aids_probe_of_a_hand_trains_as_its_20m_cell_does(robot, probe_variant, cell_variant):
     """The 5 M probe's run continues as the baoding_v1_cpu cell: nothing but the budget differs."""
     from roto.olympiad.cell import cell_spec
 
-    probe = cell_spec(load_plan("baoding_v1_more_aids"), Cell("baoding", robot, "blind", "all_three", 0))
-    cell = cell_spec(load_plan("baoding_v1_cpu"), Cell("baoding", robot, "blind", "task_critic_more_aids", 0))
+    probe = cell_spec(load_plan("baoding_v1_more_aids"), Cell("baoding", robot, "blind", probe_variant, 0))
+    cell = cell_spec(load_plan("baoding_v1_cpu"), Cell("baoding", robot, "blind", cell_variant, 0))
     assert probe.differences(cell) == {} and probe.env.replay_starts.endswith(f"{robot}_preswap.npz")
     assert (probe.steps, cell.steps) == (5_000_000, 20_000_000)
 
