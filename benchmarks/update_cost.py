@@ -6,9 +6,10 @@ Builds the learner of blind (task, robot) with the packaged agent config, fills 
 with made-up observations and rewards (no simulation: this isolates the update), and times
 ``update()`` per variant, one JSON line each: the median seconds per update over the updates after
 the first (the first compiles, captures and warms up) and the samples per second that makes.
-A variant is a set of the update's speed settings (``--variants``, default: all on a CUDA device,
-``eager`` and ``eager_fused`` on the CPU): ``cuda_graph`` replays each minibatch step from a CUDA
-graph (``ppo.cuda_graph=true``), ``fused`` steps Adam with the fused implementation
+A variant is a set of the update's speed settings (``--variants``, default: all but
+``eager_fused`` on a CUDA device, ``eager`` and ``eager_fused`` on the CPU): ``cuda_graph``
+replays each minibatch step from a CUDA graph (``ppo.cuda_graph=true``), ``fused`` steps Adam
+with the fused implementation
 (``ppo.fused_adam=true``), ``tf32`` lets the update's matrix products use TF32
 (``ppo.tf32_update=true``); ``eager`` is none of them.
 """
@@ -44,27 +45,25 @@ def fill(alg: PPO, sizes: dict[str, int], generator: torch.Generator) -> None:
     alg.compute_returns(obs())
 
 
-SETTINGS = {"cuda_graph": "ppo.cuda_graph=true", "fused": "ppo.fused_adam=true", "tf32": "ppo.tf32_update=true"}
-GPU_VARIANTS = ("eager", "eager_tf32", "cuda_graph", "cuda_graph_tf32", "cuda_graph_fused", "cuda_graph_fused_tf32")
+GRAPH, FUSED, TF32 = "ppo.cuda_graph=true", "ppo.fused_adam=true", "ppo.tf32_update=true"
+VARIANTS = {
+    "eager": [],
+    "eager_fused": [FUSED],
+    "eager_tf32": [TF32],
+    "cuda_graph": [GRAPH],
+    "cuda_graph_tf32": [GRAPH, TF32],
+    "cuda_graph_fused": [GRAPH, FUSED],
+    "cuda_graph_fused_tf32": [GRAPH, FUSED, TF32],
+}
+"""Variant name -> the agent-config overrides it times."""
 CPU_VARIANTS = ("eager", "eager_fused")
-
-
-def variant_overrides(variant: str) -> list[str]:
-    """The agent-config overrides of a variant name (``eager`` or settings joined by ``_``)."""
-    rest, overrides = variant.removeprefix("eager").strip("_"), []
-    for name in sorted(SETTINGS, key=len, reverse=True):  # cuda_graph before its own underscore
-        if name in rest:
-            overrides.append(SETTINGS[name])
-            rest = rest.replace(name, "", 1)
-    if rest.strip("_"):
-        raise ValueError(f"unknown variant {variant!r}: eager, or any of {sorted(SETTINGS)} joined by '_'")
-    return overrides
+GPU_VARIANTS = tuple(name for name in VARIANTS if name != "eager_fused")
 
 
 def measure(args: argparse.Namespace, variant: str) -> dict[str, object]:
     """Median seconds per update of one variant."""
     device = torch.device(args.device)
-    agent = load_agent_config(args.task, args.agent_cfg, variant_overrides(variant))
+    agent = load_agent_config(args.task, args.agent_cfg, VARIANTS[variant])
     groups = extra_groups(agent, "blind")  # a privileged critic's groups come from the env too
     probe = RotoEnv(EnvConfig(task=args.task, robot=args.robot, num_envs=1, extra_groups=groups))
     sizes, num_actions = stacked_sizes(probe), probe.num_actions
@@ -104,17 +103,11 @@ def main() -> None:
     parser.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
     parser.add_argument("--num_envs", type=int, default=8192)
     parser.add_argument("--updates", type=int, default=6, help="timed updates per variant (the first is dropped)")
-    parser.add_argument("--variants", nargs="+", default=None, help="variant names (see above)")
+    parser.add_argument("--variants", nargs="+", default=None, choices=list(VARIANTS), help="default: see above")
     args = parser.parse_args()
     if args.updates < 2:
         parser.error(f"--updates must be >= 2 (the first one is not counted), got {args.updates}")
-    variants = args.variants or (CPU_VARIANTS if args.device == "cpu" else GPU_VARIANTS)
-    for variant in variants:
-        try:
-            variant_overrides(variant)
-        except ValueError as error:
-            parser.error(str(error))
-    for variant in variants:
+    for variant in args.variants or (CPU_VARIANTS if args.device == "cpu" else GPU_VARIANTS):
         print(json.dumps(measure(args, variant)), flush=True)
 
 
