@@ -9,6 +9,17 @@ from dataclasses import dataclass
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, TOUCH_MODES
 from roto.sim.backend import BACKENDS
 
+TRAINING_AID_FIELDS = (
+    "replay_starts",
+    "replay_share",
+    "replay_record_lead",
+    "replay_record_capacity",
+    "tolerance_start",
+    "tolerance_target",
+)
+"""The env fields that are training aids: a run's training envs may set them; evaluation and the
+benchmark never do (``EnvConfig.without_training_aids``)."""
+
 
 @dataclass(frozen=True, kw_only=True)
 class EnvConfig:
@@ -116,10 +127,9 @@ class EnvConfig:
         self._check_device()
 
     def without_training_aids(self) -> EnvConfig:
-        """This config as the benchmark defines the task: no replayed starts."""
-        return dataclasses.replace(
-            self, replay_starts=None, replay_share=0.0, replay_record_lead=0, tolerance_start=0.0
-        )
+        """This config as the benchmark defines the task: every training aid at its default (off)."""
+        defaults = {f.name: f.default for f in dataclasses.fields(EnvConfig) if f.name in TRAINING_AID_FIELDS}
+        return dataclasses.replace(self, **defaults)
 
     def _check_replay(self) -> None:
         share = self.replay_share

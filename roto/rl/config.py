@@ -2,7 +2,9 @@
 
 A config file mirrors ``AgentConfig``: sections ``network``, ``ppo``, ``ssl`` and ``run``. An unknown
 key is an error naming its dotted path and the valid keys; a missing key keeps its default. A file
-may start from another with ``extends: NAME`` and list only what it changes.
+may start from another with ``extends: NAME`` and list only what it changes. An optional
+``training_aids`` section sets training-only env settings (``TRAINING_AID_FIELDS``: replayed
+starts, the tolerance curriculum) that the run's training envs use and evaluation never does.
 ``key=value`` overrides (e.g. ``ppo.lr=1e-4``, ``ssl.forward_dynamics.weight=0.01``) are applied on
 top, with the value parsed as YAML.
 """
@@ -20,6 +22,7 @@ from typing import Any
 
 import yaml
 
+from roto.envs.config import TRAINING_AID_FIELDS
 from roto.rl.ssl.configs import SSLConfig, check_groups
 from roto.yaml_files import read_yaml
 
@@ -268,6 +271,8 @@ def resolve_config_path(task: str, path: str | pathlib.Path | None) -> pathlib.P
 
 EXTENDS = "extends"
 """Top-level key of an agent config naming the config it changes (a packaged name or a file)."""
+TRAINING_AIDS = "training_aids"
+"""Top-level section of an agent config with training-only env settings (``TRAINING_AID_FIELDS``)."""
 
 
 def merge(base: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
@@ -313,10 +318,27 @@ def read_agent_data(config_path: pathlib.Path, chain: tuple[pathlib.Path, ...] =
 def load_agent_config(
     task: str, path: str | pathlib.Path | None = None, overrides: list[str] | None = None
 ) -> AgentConfig:
-    """The task's default config, or ``path`` (a YAML file or packaged name), with ``overrides``; validated."""
-    data = read_agent_data(resolve_config_path(task, path))
+    """The task's default config, or ``path`` (a YAML file or packaged name), with ``overrides``;
+    validated. Its ``training_aids`` section is the env's (``load_training_aids``)."""
+    data = dict(read_agent_data(resolve_config_path(task, path)))
+    data.pop(TRAINING_AIDS, None)
     data = apply_overrides(data, overrides or [])
     return from_dict(AgentConfig, data).validate()
+
+
+def load_training_aids(task: str, path: str | pathlib.Path | None, robot: str) -> dict[str, Any]:
+    """{env field: value} of the config's ``training_aids`` section ({} without one), ``{robot}``
+    in a text value replaced by ``robot`` (e.g. a per-hand bank of recorded starts). A key that is
+    not a training aid is a ValueError naming the valid ones."""
+    config_path = resolve_config_path(task, path)
+    aids = read_agent_data(config_path).get(TRAINING_AIDS) or {}
+    if not isinstance(aids, dict) or set(aids) - set(TRAINING_AID_FIELDS):
+        unknown = sorted(set(aids) - set(TRAINING_AID_FIELDS)) if isinstance(aids, dict) else aids
+        raise ValueError(
+            f"agent config {str(config_path)!r}: {TRAINING_AIDS} {unknown!r} are not training aids; "
+            f"valid keys: {list(TRAINING_AID_FIELDS)}"
+        )
+    return {key: value.replace("{robot}", robot) if isinstance(value, str) else value for key, value in aids.items()}
 
 
 __all__ = [
@@ -328,6 +350,7 @@ __all__ = [
     "apply_overrides",
     "from_dict",
     "load_agent_config",
+    "load_training_aids",
     "packaged_configs",
     "parse_override",
     "to_dict",

@@ -104,7 +104,11 @@ def help_config() -> str:
 
     lines = ["Agent config keys (a YAML file's sections, or section.key=value overrides), with their defaults:"]
     lines += block(config_keys(AgentConfig))
-    lines += ["", "Env keys (env.key=value overrides; task, robot and obs mode are the run's own flags):"]
+    lines += [
+        "",
+        "Env keys (env.key=value overrides; task, robot and obs mode are the run's own flags; the training aids"
+        " among them may also be set in an agent config's training_aids section, {robot} standing for the hand):",
+    ]
     lines += block(config_keys(EnvConfig, "env.", skip=FIXED_ENV_KEYS))
     return "\n".join(lines)
 

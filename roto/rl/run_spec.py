@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from roto.envs.config import EnvConfig
-from roto.rl.config import AgentConfig, load_agent_config, to_dict
+from roto.rl.config import AgentConfig, load_agent_config, load_training_aids, to_dict
 from roto.rl.overrides import apply_env_overrides, split_overrides
 from roto.rl.settings import TrainSettings
 
@@ -73,11 +73,13 @@ def build_run_spec(
     name, or None: the task's default) and ``overrides``.
 
     ``env_fields`` set env fields directly (the CLI's ``--num_envs``, ``--backend`` ... flags);
-    ``env.*`` overrides are applied after them, so an override wins over a flag. Everything is
-    validated here, before any directory or env exists.
+    the agent config's ``training_aids`` and then the ``env.*`` overrides are applied after them, so
+    an override wins over the config and a flag. Everything is validated here, before any directory
+    or env exists.
     """
     env_changes, agent_overrides = split_overrides(list(overrides))
-    env = apply_env_overrides(EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields), env_changes)
+    aids = load_training_aids(task, agent_cfg, robot)
+    env = apply_env_overrides(EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields), {**aids, **env_changes})
     agent = load_agent_config(task, agent_cfg, agent_overrides)
     TrainSettings(env=env, total_steps=steps)  # checks the budget
     return RunSpec(env=env, agent=agent, steps=steps)

@@ -194,3 +194,23 @@ def test_the_low_noise_variant_differs_from_all_three_only_in_the_policy_std():
         "agent.network.init_log_std": (-1.386, 0.0),
         "agent.network.max_log_std": (-1.386, 2.0),
     }
+
+
+@pytest.mark.parametrize(
+    ("robot", "variant"),
+    [
+        ("shadow", "task_critic_replay"),
+        ("shadow_lite", "task_critic_more_aids"),
+        ("orca", "task_critic_more_aids_low_noise"),
+    ],
+)
+def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(robot, variant):
+    """``roto train --agent_cfg baoding_cpu_<hand>`` is the recipe behind the hand's Baoding result."""
+    from roto.olympiad.cell import cell_spec
+    from roto.rl.run_spec import build_run_spec
+
+    plan = load_plan("baoding_v1_cpu")
+    cell = cell_spec(plan, Cell("baoding", robot, "blind", variant, 0))
+    config = f"baoding_cpu_{robot}"
+    packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=2)
+    assert packaged.differences(cell) == {} and packaged.env.replay_starts.endswith(f"{robot}_preswap.npz")

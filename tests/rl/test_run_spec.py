@@ -16,6 +16,22 @@ def test_env_overrides_set_any_env_field_and_win_over_flags():
     assert spec.agent.ppo.lr == 1e-3 and spec.agent.ppo.epochs == 5 and spec.steps == 64
 
 
+def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_wins(tmp_path):
+    base = tmp_path / "aided.yaml"
+    base.write_text(
+        "extends: baoding_cpu\ntraining_aids:\n  replay_starts: banks/{robot}.npz\n  replay_share: 0.25\n"
+        "  tolerance_start: 0.025\n"
+    )
+    (tmp_path / "more.yaml").write_text("extends: aided.yaml\ntraining_aids:\n  replay_share: 0.5\n")
+    spec = build_run_spec("baoding", "allegro", "blind", str(tmp_path / "more.yaml"), ["env.tolerance_start=0.02"])
+    assert (spec.env.replay_starts, spec.env.replay_share) == ("banks/allegro.npz", 0.5)  # merged through extends
+    assert spec.env.tolerance_start == 0.02 and spec.agent.ppo.epochs == 4  # the override wins; baoding_cpu's agent
+    assert spec.env.without_training_aids() == build_run_spec("baoding", "allegro", "blind", "baoding_cpu").env
+    base.write_text("extends: baoding_cpu\ntraining_aids:\n  num_envs: 4096\n")
+    with pytest.raises(ValueError, match=r"\['num_envs'\] are not training aids; valid keys: \['replay_starts'"):
+        build_run_spec("baoding", "allegro", "blind", str(base))
+
+
 @pytest.mark.parametrize(
     ("overrides", "message"),
     [
