@@ -85,8 +85,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         return _demo_baoding(args)
     from roto.scripted import run_scripted_bounce
 
-    if args.preswap_out is not None:
-        raise ValueError("--preswap_out is for --task baoding (the Bounce script makes no swaps)")
+    if args.preswap_out is not None or args.preswap_leads is not None:
+        raise ValueError("--preswap_out and --preswap_leads are for --task baoding (the Bounce script makes no swaps)")
     stats = run_scripted_bounce(
         robot=args.robot,
         num_envs=args.num_envs,
@@ -103,8 +103,10 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _demo_baoding(args: argparse.Namespace) -> int:
     import pathlib
 
-    from roto.reference.baoding_controller import run_reference_baoding
+    from roto.reference.baoding_controller import PRESWAP_LEAD, run_reference_baoding
 
+    if args.preswap_leads is not None and args.preswap_out is None:
+        raise ValueError(f"--preswap_leads {args.preswap_leads} records states for --preswap_out; give that file too")
     if args.backend != "cpu":
         raise ValueError(f"backend {args.backend!r}: the Baoding reference controller plans on 'cpu' only")
     out = pathlib.Path(args.preswap_out) if args.preswap_out else None
@@ -116,6 +118,7 @@ def _demo_baoding(args: argparse.Namespace) -> int:
         seed=args.seed,
         threads=args.threads,
         preswap_path=out,
+        preswap_leads=tuple(args.preswap_leads or (PRESWAP_LEAD,)),
         progress=True,
     )
     print(json.dumps(stats))
@@ -331,6 +334,16 @@ def _add_demo_parser(sub: argparse._SubParsersAction) -> None:
         dest="preswap_out",
         default=None,
         help="Baoding: write the states recorded just before each swap to this .npz",
+    )
+    p_demo.add_argument(
+        "--preswap_leads",
+        "--preswap-leads",
+        dest="preswap_leads",
+        type=int,
+        nargs="+",
+        default=None,
+        help="Baoding: the control steps before each swap at which --preswap_out records a state (default: 10, "
+        "1/6 s; e.g. 10 20 30 40 50 spans the reference's whole cycle between swaps)",
     )
     p_demo.set_defaults(func=_cmd_demo)
 

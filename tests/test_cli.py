@@ -38,6 +38,8 @@ def test_baoding_demo_refuses_what_the_reference_controller_cannot_do(capsys, tm
     assert main(["demo", "--task", "baoding", "--preswap_out", str(missing)]) == 2
     assert f"directory {str(missing.parent)!r} does not exist" in capsys.readouterr().err
     assert main(["demo", "--task", "bounce", "--preswap_out", str(tmp_path / "s.npz")]) == 2
-    assert "--preswap_out is for --task baoding" in capsys.readouterr().err
+    assert "--preswap_out and --preswap_leads are for --task baoding" in capsys.readouterr().err
+    assert main(["demo", "--task", "baoding", "--preswap_leads", "10", "20"]) == 2
+    assert "--preswap_leads [10, 20] records states for --preswap_out" in capsys.readouterr().err
     assert main(["demo", "--task", "baoding", "--episodes", "0"]) == 2
     assert "episodes must be an integer >= 1, got 0" in capsys.readouterr().err

@@ -14,6 +14,7 @@ import json
 import sys
 import time
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,12 +34,25 @@ PRESWAP_LEAD = 10
 
 @dataclass
 class PreswapStates:
-    """States recorded ``PRESWAP_LEAD`` control steps before swaps, one row each."""
+    """States recorded a few control steps before swaps (``PRESWAP_LEAD`` by default), one row each."""
 
     physics: list[np.ndarray] = field(default_factory=list)  # (nstate,) mjSTATE_FULLPHYSICS
     target: list[np.ndarray] = field(default_factory=list)  # (nu,) joint targets held then
     swapped: list[bool] = field(default_factory=list)  # target assignment then
     latched: list[np.ndarray] = field(default_factory=list)  # (2,) latches then
+    lead: list[int] = field(default_factory=list)  # control steps before the swap
+
+    def record(self, history: Sequence[tuple[np.ndarray, np.ndarray, bool, np.ndarray]], leads: Sequence[int]) -> None:
+        """At a swap: add the state ``lead`` steps before it for each of ``leads`` that ``history``
+        (the states before the swap's step, oldest first; ``history[-1]`` is 1 step before) reaches."""
+        for lead in leads:
+            if lead <= len(history):
+                physics, target, was_swapped, was_latched = history[-lead]
+                self.physics.append(physics)
+                self.target.append(target)
+                self.swapped.append(was_swapped)
+                self.latched.append(was_latched)
+                self.lead.append(lead)
 
 
 class BaodingReference:
@@ -71,15 +85,18 @@ class BaodingReference:
         return target_to_action(torch.from_numpy(joint_target)[None], env._idx.ctrl_lo, env._idx.ctrl_hi)
 
 
-def run_reference_episode(controller: BaodingReference, preswap: PreswapStates | None = None) -> dict[str, float]:
-    """One episode of the controller's env (reset here); records pre-swap states into ``preswap``.
+def run_reference_episode(
+    controller: BaodingReference, preswap: PreswapStates | None = None, leads: Sequence[int] = (PRESWAP_LEAD,)
+) -> dict[str, float]:
+    """One episode of the controller's env (reset here); records into ``preswap`` the states
+    ``leads`` control steps before each swap.
 
     Returns the episode's swaps, rotations, return, length and seconds of wall time.
     """
     env = controller.env
     env.reset()
     controller.start()
-    history: deque[tuple[np.ndarray, np.ndarray, bool, np.ndarray]] = deque(maxlen=PRESWAP_LEAD)
+    history: deque[tuple[np.ndarray, np.ndarray, bool, np.ndarray]] = deque(maxlen=max(leads))
     start = time.perf_counter()
     while True:
         history.append(
@@ -91,12 +108,8 @@ def run_reference_episode(controller: BaodingReference, preswap: PreswapStates |
             )
         )
         _, _, terminated, truncated, info = env.step(controller.act())
-        if preswap is not None and float(info["reward_terms"]["swap"][0]) > 0 and len(history) == PRESWAP_LEAD:
-            physics, target, was_swapped, was_latched = history[0]
-            preswap.physics.append(physics)
-            preswap.target.append(target)
-            preswap.swapped.append(was_swapped)
-            preswap.latched.append(was_latched)
+        if preswap is not None and float(info["reward_terms"]["swap"][0]) > 0:
+            preswap.record(history, leads)
         if bool(terminated[0] | truncated[0]):
             episode = info["episode"]
             return {
@@ -130,12 +143,12 @@ def reference_env(robot: str, seed: int, episode_steps: int = 600, **options: ob
 
 
 def save_preswap_states(path, robot: str, states: PreswapStates) -> None:
-    """Write the pre-swap states to an ``.npz`` (arrays named as ``PreswapStates``' fields), the
-    format an env's ``replay_starts`` reads (``roto.envs.replay_starts``)."""
+    """Write the pre-swap states to an ``.npz`` (arrays named as ``PreswapStates``' fields, the
+    leads as ``lead_steps``), the format an env's ``replay_starts`` reads (``roto.envs.replay_starts``)."""
     np.savez_compressed(
         path,
         robot=np.array(robot),
-        lead_steps=np.array(PRESWAP_LEAD),
+        lead_steps=np.array(states.lead, dtype=np.int64),
         physics=np.array(states.physics).reshape(len(states.physics), -1),
         target=np.array(states.target).reshape(len(states.target), -1),
         swapped=np.array(states.swapped, dtype=bool),
@@ -149,6 +162,7 @@ def run_reference_baoding(
     seed: int = 0,
     threads: int = 2,
     preswap_path=None,
+    preswap_leads: Sequence[int] = (PRESWAP_LEAD,),
     progress: bool = False,
     sampling: SamplingConfig | None = None,
     weights: BaodingCostWeights | None = None,
@@ -156,10 +170,13 @@ def run_reference_baoding(
     """``episodes`` full Baoding episodes of ``robot`` under the reference controller, one after the
     other from the env's own starts (seeded by ``seed``); their swaps and rotations per episode.
 
-    Writes the pre-swap states to ``preswap_path`` (``.npz``) when given.
+    Writes the states ``preswap_leads`` control steps before each swap to ``preswap_path``
+    (``.npz``) when given.
     """
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
+    if not preswap_leads or any(isinstance(k, bool) or not isinstance(k, int) or k < 1 for k in preswap_leads):
+        raise ValueError(f"preswap_leads must be control steps, integers >= 1, got {list(preswap_leads)!r}")
     sampling = sampling or SamplingConfig(seed=seed, threads=threads)
     weights = weights or BaodingCostWeights()
     env = reference_env(robot, seed)
@@ -169,7 +186,7 @@ def run_reference_baoding(
     per_episode = []
     try:
         for k in range(episodes):
-            result = run_reference_episode(controller, preswap)
+            result = run_reference_episode(controller, preswap, preswap_leads)
             per_episode.append(result)
             if progress:
                 print(f"episode {k + 1}/{episodes}: {json.dumps(result)}", file=sys.stderr, flush=True)
@@ -194,5 +211,6 @@ def run_reference_baoding(
         "mean_length": float(np.mean([r["length"] for r in per_episode])),
         "seconds_per_episode": float(np.mean([r["seconds"] for r in per_episode])),
         "preswap_states": len(preswap.physics),
+        "preswap_leads": list(preswap_leads),
         "per_episode": per_episode,
     }

@@ -7,7 +7,13 @@ import numpy as np
 import pytest
 import torch
 
-from roto.reference.baoding_controller import BaodingReference, reference_env
+from roto.reference.baoding_controller import (
+    BaodingReference,
+    PreswapStates,
+    reference_env,
+    run_reference_baoding,
+    save_preswap_states,
+)
 from roto.reference.baoding_cost import BaodingCostWeights
 from roto.reference.predictive_sampling import PredictiveSampling, SamplingConfig
 from roto.registry import make
@@ -27,7 +33,7 @@ def test_from_a_recorded_preswap_state_the_controller_swaps_again(seed):
     (recorded 10 control steps before one), with a planner seeded afresh. The env starts in one of
     them through its own replayed starts."""
     with np.load(PRESWAP) as saved:
-        assert int(saved["lead_steps"]) == 10 and len(saved["physics"]) >= 100
+        assert set(np.atleast_1d(saved["lead_steps"])) == {10} and len(saved["physics"]) >= 100
     env = reference_env("shadow", seed=seed, replay_starts=str(PRESWAP), replay_share=1.0)
     env.reset()
     physics = torch.from_numpy(env.backend.physics_state()[0, 1 : 1 + env.model.nq])
@@ -55,3 +61,27 @@ def test_the_controller_needs_one_world_on_the_cpu():
 def test_preswap_states_of_another_hand_are_refused():
     with pytest.raises(ValueError, match="states of robot 'shadow', not 'allegro'"):
         reference_env("allegro", seed=0, replay_starts=str(PRESWAP), replay_share=1.0)
+
+
+def test_preswap_states_are_recorded_at_each_lead_the_history_reaches(tmp_path):
+    """At a swap, the state ``lead`` steps before it for each lead (history[-1]: 1 step before);
+    a lead longer than the episode so far is skipped; the file keeps each row's lead."""
+    history = [
+        (np.full(3, k, dtype=float), np.full(2, -k, dtype=float), k % 2 == 0, np.array([k > 1, False]))
+        for k in range(6)
+    ]
+    states = PreswapStates()
+    states.record(history, (1, 3, 6, 7))
+    assert states.lead == [1, 3, 6] and [int(p[0]) for p in states.physics] == [5, 3, 0]
+    assert [int(t[0]) for t in states.target] == [-5, -3, 0] and states.swapped == [False, False, True]
+    path = tmp_path / "bank.npz"
+    save_preswap_states(path, "allegro", states)
+    with np.load(path) as saved:
+        assert saved["lead_steps"].tolist() == [1, 3, 6] and saved["physics"].shape == (3, 3)
+        assert saved["latched"].tolist() == [[True, False], [True, False], [False, False]]
+
+
+@pytest.mark.parametrize("leads", [(), (0,), (10, True)])
+def test_bad_preswap_leads_are_refused_naming_them(leads):
+    with pytest.raises(ValueError, match="preswap_leads must be control steps"):
+        run_reference_baoding("shadow", episodes=1, preswap_leads=leads)
