@@ -214,3 +214,14 @@ def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(robot, v
     config = f"baoding_cpu_{robot}"
     packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=2)
     assert packaged.differences(cell) == {} and packaged.env.replay_starts.endswith(f"{robot}_preswap.npz")
+
+
+def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_starts():
+    from roto.olympiad.cell import cell_spec
+
+    plan = load_plan("baoding_v1_more_aids")
+    cycle = cell_spec(plan, Cell("baoding", "allegro", "blind", "cycle_low_noise", 0))
+    low = cell_spec(plan, Cell("baoding", "allegro", "blind", "all_three_low_noise", 0))
+    bank = "benchmarks/results/baoding_reference/allegro_cycle.npz"
+    assert cycle.differences(low) == {"env.replay_starts": (bank, bank.replace("cycle", "preswap"))}
+    assert pathlib.Path(bank).is_file()
