@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pathlib
+import textwrap
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -79,7 +80,8 @@ def plot_variants(
         ax.set_ylabel(f"evaluation {metric} (mean over seeds)")
         ax.grid(alpha=0.3)
         ax.legend(loc="upper left")
-        ax.set_title(title)
+    if title:  # one title over the panels, wrapped to their width (a long list of commits would overlap)
+        fig.suptitle(textwrap.fill(title, width=90 * len(xs)))
     fig.tight_layout()
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
