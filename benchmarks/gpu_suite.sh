@@ -9,10 +9,11 @@
 #   scaling.jsonl     Shadow Bounce at 1k, 4k, 8k, 16k and 32k envs
 #   update_cost.jsonl one PPO update of blind Shadow Bounce at NUM_ENVS: eager, CUDA graph, fused
 #                     Adam, TF32 and mixes of them (benchmarks/update_cost.py)
-#   train_bounce_shadow/  if TRAIN_SECONDS > 0: blind Shadow Bounce at NUM_ENVS, stopped after that many
+#   train_TASK_ROBOT/ if TRAIN_SECONDS > 0: blind Shadow Bounce (TRAIN_TASK, TRAIN_ROBOT) at NUM_ENVS, stopped after that many
 #                     seconds (scalars.csv: perf/steps_per_s; evaluations.jsonl: the evaluation curve),
 #                     with policy_best.pt / policy_latest.pt (weights and settings only, for `roto eval`
-#                     and `roto play` elsewhere); TRAIN_OVERRIDES go to `roto train` (ppo.cuda_graph=true)
+#                     and `roto play` elsewhere); TRAIN_OVERRIDES go to `roto train` (ppo.cuda_graph=true,
+#                     --agent_cfg baoding_cpu_shadow)
 #   suite.log         one line per step: exit status and seconds
 # A short lease runs a subset, chosen by environment variables (defaults: everything):
 #   PAIRS="bounce:shadow"        the (task:robot) pairs benched (default all eight)
@@ -20,6 +21,7 @@
 #   PYTEST_FILES="tests/rl/..."  the GPU test files (default the three below)
 #   UPDATE_AGENTS="bounce bounce_cpu_quickstart"  agent configs whose update is timed (default bounce)
 #   DEADLINE=<epoch seconds>     training stops 60 s before it (room for the policies), whatever TRAIN_SECONDS says
+#   TRAIN_TASK=baoding TRAIN_ROBOT=shadow  what the training trains (default bounce, shadow)
 # Exits non-zero, naming the failed steps and the tail of their error output, if any step failed.
 set -uo pipefail
 out=${1:?usage: benchmarks/gpu_suite.sh OUT_DIR [TRAIN_SECONDS] [NUM_ENVS] [TRAIN_OVERRIDES...]}
@@ -62,10 +64,11 @@ if [ -n "${DEADLINE:-}" ]; then
   if [ "$left" -lt "$train_s" ]; then train_s=$(( left > 0 ? left : 0 )); fi
 fi
 if [ "$train_s" -gt 0 ]; then
-  run="$out/train_bounce_shadow"
+  train_task=${TRAIN_TASK:-bounce} train_robot=${TRAIN_ROBOT:-shadow}
+  run="$out/train_${train_task}_${train_robot}"
   # SIGINT at the time limit ends the run like Ctrl-C (exit 124 from timeout is the expected end)
-  timeout --signal=INT "$train_s" python3 -m roto.cli train --backend warp --device cuda --task bounce \
-    --robot shadow --obs blind --num_envs "$num_envs" --steps 200000000 --seed 0 --run_dir "$run" \
+  timeout --signal=INT "$train_s" python3 -m roto.cli train --backend warp --device cuda --task "$train_task" \
+    --robot "$train_robot" --obs blind --num_envs "$num_envs" --steps 200000000 --seed 0 --run_dir "$run" \
     --no_progress "${train_overrides[@]}" > "$out/train.log" 2>&1
   status=$?
   echo "train: exit $status after at most $train_s s" | tee -a "$out/suite.log"
