@@ -19,6 +19,8 @@ from roto.envs.config import EnvConfig
 from roto.rl.config import AgentConfig, load_agent_config, load_training_aids, to_dict
 from roto.rl.overrides import apply_env_overrides, split_overrides
 from roto.rl.settings import TrainSettings
+from roto.robots import get_robot
+from roto.tasks import get_task
 
 DEFAULT_STEPS = 1_000_000
 
@@ -77,9 +79,10 @@ def build_run_spec(
     an override wins over the config and a flag. Everything is validated here, before any directory
     or env exists.
     """
+    task, robot = get_task(task).name, get_robot(robot).name  # any case, as roto.make; a bad name is refused
     env_changes, agent_overrides = split_overrides(list(overrides))
-    aids = load_training_aids(task, agent_cfg, robot)
-    env = apply_env_overrides(EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields), {**aids, **env_changes})
+    env = EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields)
+    env = apply_env_overrides(env, {**load_training_aids(task, agent_cfg, robot), **env_changes})
     agent = load_agent_config(task, agent_cfg, agent_overrides)
     TrainSettings(env=env, total_steps=steps)  # checks the budget
     return RunSpec(env=env, agent=agent, steps=steps)

@@ -23,7 +23,8 @@ def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_
         "  tolerance_start: 0.025\n"
     )
     (tmp_path / "more.yaml").write_text("extends: aided.yaml\ntraining_aids:\n  replay_share: 0.5\n")
-    spec = build_run_spec("baoding", "allegro", "blind", str(tmp_path / "more.yaml"), ["env.tolerance_start=0.02"])
+    spec = build_run_spec("Baoding", "Allegro", "blind", str(tmp_path / "more.yaml"), ["env.tolerance_start=0.02"])
+    assert (spec.env.task, spec.env.robot) == ("baoding", "allegro")  # names in any case, as roto.make takes them
     assert (spec.env.replay_starts, spec.env.replay_share) == ("banks/allegro.npz", 0.5)  # merged through extends
     assert spec.env.tolerance_start == 0.02 and spec.agent.ppo.epochs == 4  # the override wins; baoding_cpu's agent
     assert spec.env.without_training_aids() == build_run_spec("baoding", "allegro", "blind", "baoding_cpu").env
