@@ -9,7 +9,7 @@
 #   scaling.jsonl     Shadow Bounce at 1k, 4k, 8k, 16k and 32k envs
 #   update_cost.jsonl one PPO update of blind Shadow Bounce at NUM_ENVS: eager, CUDA graph, fused
 #                     Adam, TF32 and mixes of them (benchmarks/update_cost.py)
-#   train_TASK_ROBOT/ if TRAIN_SECONDS > 0: blind Shadow Bounce (TRAIN_TASK, TRAIN_ROBOT) at NUM_ENVS, stopped after that many
+#   train_TASK_ROBOT/ if TRAIN_SECONDS > 0: blind TRAIN_TASK on TRAIN_ROBOT (default bounce, shadow) at NUM_ENVS, stopped after that many
 #                     seconds (scalars.csv: perf/steps_per_s; evaluations.jsonl: the evaluation curve),
 #                     with policy_best.pt / policy_latest.pt (weights and settings only, for `roto eval`
 #                     and `roto play` elsewhere); TRAIN_OVERRIDES go to `roto train` (ppo.cuda_graph=true,

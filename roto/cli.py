@@ -154,7 +154,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         steps = args.steps if args.steps is not None else DEFAULT_STEPS
         spec = build_run_spec(args.task, args.robot, args.obs, args.agent_cfg, args.overrides, steps, **flags)
         run_dir = args.run_dir or pathlib.Path("runs") / (
-            f"{args.task}_{args.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{spec.env.seed}"
+            f"{spec.env.task}_{spec.env.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{spec.env.seed}"
         )
         if (pathlib.Path(run_dir) / CONFIG_NAME).exists():
             raise ValueError(
@@ -343,7 +343,7 @@ def _add_demo_parser(sub: argparse._SubParsersAction) -> None:
         nargs="+",
         default=None,
         help="Baoding: the control steps before each swap at which --preswap_out records a state (default: 10, "
-        "1/6 s; e.g. 10 20 30 40 50 spans the reference's whole cycle between swaps)",
+        "1/6 s; e.g. 10 20 30 40 50 60: the last second before each swap, back past the swap before it)",
     )
     p_demo.set_defaults(func=_cmd_demo)
 

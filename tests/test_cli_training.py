@@ -275,3 +275,12 @@ def test_a_second_resume_of_a_run_in_use_is_refused_naming_the_process(trained_r
         holder._lock.close()
         holder.env.close()
         holder.evaluator.env.close()
+
+
+def test_task_and_robot_names_in_any_case_train_into_the_canonical_run_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    args = ["train", "--task", "Bounce", "--robot", "Shadow-Lite", "--num_envs", "2", "--steps", "8", "--no_progress"]
+    assert main([*args, *TINY]) == 0
+    (run,) = (tmp_path / "runs" / "bounce_shadow_lite_blind").iterdir()
+    settings = yaml.safe_load((run / "config.yaml").read_text())["train"]["env"]
+    assert (settings["task"], settings["robot"]) == ("bounce", "shadow_lite")

@@ -66,7 +66,10 @@ def load_replay_bank(path: str, model: mujoco.MjModel, robot: str, task_state: o
         no state.
     """
     if not pathlib.Path(path).is_file():  # checked here, where it is read: a run's config stays loadable without it
-        raise ValueError(f"replay_starts {str(path)!r} is not a file")
+        raise ValueError(
+            f"replay_starts {str(path)!r} is not a file (a relative path is read from the current directory, "
+            f"{str(pathlib.Path.cwd())!r}; the packaged configs' banks are relative to the repository root)"
+        )
     with np.load(path, allow_pickle=False) as saved:
         arrays = {name: saved[name] for name in saved.files}
     if "robot" in arrays and str(arrays["robot"]) != robot:

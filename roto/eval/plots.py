@@ -81,7 +81,7 @@ def plot_variants(
         ax.grid(alpha=0.3)
         ax.legend(loc="upper left")
     if title:  # one title over the panels, wrapped to their width (a long list of commits would overlap)
-        fig.suptitle(textwrap.fill(title, width=90 * len(xs)))
+        fig.suptitle(textwrap.fill(title, width=75 * len(xs)))
     fig.tight_layout()
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -320,8 +320,9 @@ def load_agent_config(
 ) -> AgentConfig:
     """The task's default config, or ``path`` (a YAML file or packaged name), with ``overrides``;
     validated. Its ``training_aids`` section is the env's (``load_training_aids``)."""
-    data = dict(read_agent_data(resolve_config_path(task, path)))
-    data.pop(TRAINING_AIDS, None)
+    data = read_agent_data(resolve_config_path(task, path))
+    if isinstance(data, dict):  # anything else: from_dict says it must be a mapping
+        data = {key: value for key, value in data.items() if key != TRAINING_AIDS}
     data = apply_overrides(data, overrides or [])
     return from_dict(AgentConfig, data).validate()
 
@@ -331,13 +332,14 @@ def load_training_aids(task: str, path: str | pathlib.Path | None, robot: str) -
     in a text value replaced by ``robot`` (e.g. a per-hand bank of recorded starts). A key that is
     not a training aid is a ValueError naming the valid ones."""
     config_path = resolve_config_path(task, path)
-    aids = read_agent_data(config_path).get(TRAINING_AIDS) or {}
-    if not isinstance(aids, dict) or set(aids) - set(TRAINING_AID_FIELDS):
-        unknown = sorted(set(aids) - set(TRAINING_AID_FIELDS)) if isinstance(aids, dict) else aids
-        raise ValueError(
-            f"agent config {str(config_path)!r}: {TRAINING_AIDS} {unknown!r} are not training aids; "
-            f"valid keys: {list(TRAINING_AID_FIELDS)}"
-        )
+    data = read_agent_data(config_path)
+    aids = (data.get(TRAINING_AIDS) if isinstance(data, dict) else None) or {}
+    where = f"agent config {str(config_path)!r}: {TRAINING_AIDS}"
+    if not isinstance(aids, dict):
+        raise ValueError(f"{where} must be a mapping of env fields to values, got {aids!r}")
+    if set(aids) - set(TRAINING_AID_FIELDS):
+        unknown = sorted(set(aids) - set(TRAINING_AID_FIELDS))
+        raise ValueError(f"{where} {unknown!r} are not training aids; valid keys: {list(TRAINING_AID_FIELDS)}")
     return {key: value.replace("{robot}", robot) if isinstance(value, str) else value for key, value in aids.items()}
 
 

@@ -81,8 +81,13 @@ def build_run_spec(
     """
     task, robot = get_task(task).name, get_robot(robot).name  # any case, as roto.make; a bad name is refused
     env_changes, agent_overrides = split_overrides(list(overrides))
-    env = EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields)
-    env = apply_env_overrides(env, {**load_training_aids(task, agent_cfg, robot), **env_changes})
+    env = training_env(EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields), agent_cfg, env_changes)
     agent = load_agent_config(task, agent_cfg, agent_overrides)
     TrainSettings(env=env, total_steps=steps)  # checks the budget
     return RunSpec(env=env, agent=agent, steps=steps)
+
+
+def training_env(env: EnvConfig, agent_cfg: str | None, env_changes: dict[str, Any]) -> EnvConfig:
+    """The training envs' config: ``env`` with the agent config's ``training_aids`` (for ``env``'s
+    task and robot), then ``env_changes`` (the ``env.*`` overrides, which win)."""
+    return apply_env_overrides(env, {**load_training_aids(env.task, agent_cfg, env.robot), **env_changes})

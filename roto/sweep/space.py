@@ -28,6 +28,7 @@ import optuna
 from roto.envs.config import EnvConfig
 from roto.rl.config import AgentConfig, from_dict, load_agent_config
 from roto.rl.overrides import apply_env_overrides, split_overrides
+from roto.rl.run_spec import training_env
 from roto.rl.ssl.configs import SSLConfig
 from roto.yaml_files import read_yaml
 
@@ -166,7 +167,7 @@ def load_space(space: str, env: EnvConfig, agent_cfg: str | None = None, overrid
         extra = sorted(set(data) - set(SPACE_KEYS)) if isinstance(data, dict) else data
         raise ValueError(f"{where}: unknown sections {extra}; valid sections: {list(SPACE_KEYS)}")
     env_changes, agent_overrides = split_overrides(list(overrides))
-    env = apply_env_overrides(env, env_changes)
+    env = training_env(env, agent_cfg, env_changes)
     base = load_agent_config(env.task, agent_cfg, agent_overrides)
     parameters = [parse_parameter(str(k), v, where) for k, v in (data.get("parameters") or {}).items()]
     known = _aux_fields()

@@ -131,7 +131,8 @@ def enqueue_base(study: optuna.Study, settings: SweepSettings, space: Any) -> tu
     as usual where not. Only into a study without trials (ValueError otherwise); returns
     (the enqueued values, the base values outside the space)."""
     from roto.rl.config import load_agent_config
-    from roto.rl.overrides import apply_env_overrides, split_overrides
+    from roto.rl.overrides import split_overrides
+    from roto.rl.run_spec import training_env
     from roto.sweep.space import base_values
 
     if study.trials:
@@ -140,7 +141,7 @@ def enqueue_base(study: optuna.Study, settings: SweepSettings, space: Any) -> tu
             "enqueued only as a new study's first trial"
         )
     env_changes, agent_overrides = split_overrides(list(settings.overrides))
-    env = apply_env_overrides(settings.base_env(), env_changes)
+    env = training_env(settings.base_env(), settings.agent_cfg, env_changes)
     inside, outside = base_values(space, env, load_agent_config(settings.task, settings.agent_cfg, agent_overrides))
     study.enqueue_trial(inside)
     return inside, outside

@@ -31,6 +31,9 @@ def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_
     base.write_text("extends: baoding_cpu\ntraining_aids:\n  num_envs: 4096\n")
     with pytest.raises(ValueError, match=r"\['num_envs'\] are not training aids; valid keys: \['replay_starts'"):
         build_run_spec("baoding", "allegro", "blind", str(base))
+    base.write_text("extends: baoding_cpu\ntraining_aids: [replay_share]\n")
+    with pytest.raises(ValueError, match=r"training_aids must be a mapping of env fields to values, got \[.replay"):
+        build_run_spec("baoding", "allegro", "blind", str(base))
 
 
 @pytest.mark.parametrize(

@@ -29,6 +29,8 @@ def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load
     assert [p.key for p in baoding.parameters] == [*(p.key for p in plain.parameters), "env.replay_share"]
     with pytest.raises(ValueError, match=r"replay_share 0\.1 needs replay_starts"):  # the bank is the study's to set
         load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu")
+    recipe = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu_shadow")  # its own bank
+    assert [p.key for p in recipe.parameters] == [p.key for p in baoding.parameters]
 
 
 def test_ssl_parameters_expand_over_the_base_configs_auxiliary_losses():

@@ -201,6 +201,18 @@ def test_the_base_config_is_enqueued_as_the_first_trial_where_the_space_can_draw
         enqueue_base(study, settings, space)
 
 
+def test_the_enqueued_base_has_the_training_aids_of_its_agent_config(tmp_path):
+    from roto.sweep.space import load_space
+    from roto.sweep.study import SweepSettings, enqueue_base
+
+    settings = SweepSettings(study="aids", task="baoding", agent_cfg="baoding_cpu_shadow", space="baoding_cpu",
+                             objective="metric", trials=2, num_envs=8, root=str(tmp_path))  # fmt: skip
+    study, _ = open_study(settings)
+    space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
+    inside, _ = enqueue_base(study, settings, space)
+    assert inside["env.replay_share"] == 0.25 and inside["ppo.epochs"] == 4  # baoding_cpu_shadow's, not defaults
+
+
 def test_joining_a_study_with_other_settings_is_an_error(tmp_path):
     open_study(toy_settings(tmp_path, trials=4))
     with pytest.raises(ValueError, match=r"exists with other settings.*'steps': \(192, 320\)"):
