@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
 import operator
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -19,6 +18,7 @@ import mujoco
 import numpy as np
 import torch
 
+from roto.envs.action_checks import check_action_finite, check_action_layout
 from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
@@ -280,28 +280,11 @@ class RotoEnv:
         return {group: sizes[group] for group in self.groups}
 
     def _check_action(self, action: Any) -> torch.Tensor:
-        expected = (self.num_envs, self.num_actions)
-        if not isinstance(action, torch.Tensor):
-            raise TypeError(f"action must be a torch.Tensor of shape {expected}, got {type(action).__name__}")
-        if tuple(action.shape) != expected:
-            raise ValueError(
-                f"action shape {tuple(action.shape)} is wrong; expected (num_envs, num_actions) = {expected}"
-            )
-        if not action.is_floating_point():
-            raise TypeError(f"action dtype {action.dtype} is not floating point; use torch.float32 or torch.float64")
-        if action.device != self.device:
-            raise ValueError(f"action is on device {action.device}; this env runs on {self.device}")
+        action = check_action_layout(action, (self.num_envs, self.num_actions), self.device)
         if self.sync_free_step:  # read every `check_every` steps (_periodic_check)
             self._actions_finite &= torch.isfinite(action).all()
-            return action
-        # one reduction instead of an element-wise check: a NaN or inf anywhere makes the sum
-        # non-finite; a sum that overflowed from finite values is told apart by the full check
-        if not math.isfinite(float(action.sum())):
-            bad = torch.nonzero(~torch.isfinite(action).all(dim=1)).flatten().tolist()
-            if bad:
-                raise ValueError(
-                    f"action has non-finite values (NaN or inf) in envs {bad[:10]}; actions must be finite"
-                )
+        else:
+            check_action_finite(action)
         return action
 
     def _ensure_starts(self, done: torch.Tensor) -> bool:
