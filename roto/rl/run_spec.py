@@ -23,6 +23,8 @@ from roto.robots import get_robot
 from roto.tasks import get_task
 
 DEFAULT_STEPS = 1_000_000
+EXECUTION_KEYS = ("env.threads",)
+"""Spec keys that say how fast a run trains, not what: a run continues under other values."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -44,11 +46,14 @@ class RunSpec:
         return dataclasses.replace(self, env=dataclasses.replace(self.env, seed=seed))
 
     def differences(self, other: RunSpec) -> dict[str, tuple[Any, Any]]:
-        """{dotted key: (this value, other's value)} where the two specs train differently (the
-        budget aside: a run may be extended)."""
+        """{dotted key: (this value, other's value)} where the two specs train differently. The
+        budget and the C threads aside (``EXECUTION_KEYS``): a run may be extended, and continued
+        on another number of threads, which step the same worlds to the same states
+        (tests/envs/test_determinism.py)."""
         mine = {"env": dataclasses.asdict(self.env), "agent": to_dict(self.agent)}
         theirs = {"env": dataclasses.asdict(other.env), "agent": to_dict(other.agent)}
-        return {key: pair for key, pair in _flat_pairs(mine, theirs).items() if pair[0] != pair[1]}
+        pairs = _flat_pairs(mine, theirs).items()
+        return {key: pair for key, pair in pairs if pair[0] != pair[1] and key not in EXECUTION_KEYS}
 
 
 def _flat_pairs(a: dict[str, Any], b: dict[str, Any], prefix: str = "") -> dict[str, tuple[Any, Any]]:

@@ -306,7 +306,8 @@ class Trainer:
         from ``spec``.
 
         With a spec, a run that exists must train what the spec says (only its budget may grow,
-        to ``spec.steps``); without one, ``steps`` is a new budget for the run (None: unchanged).
+        to ``spec.steps``, and it continues on ``spec.env.threads``); without one, ``steps`` is a
+        new budget for the run (None: unchanged).
 
         Raises:
             ValueError listing the differences when an existing run was configured otherwise;
@@ -324,7 +325,8 @@ class Trainer:
                         "it is, or start another run directory"
                     )
                 steps = spec.steps
-            return cls.resume(run_dir, steps, tensorboard, env_factory, wandb_project)
+            threads = spec.env.threads if spec is not None else None
+            return cls.resume(run_dir, steps, tensorboard, env_factory, wandb_project, threads=threads)
         trainer = cls(spec.settings, spec.agent, run_dir, tensorboard, env_factory, wandb_project)
         trainer.evaluator.drop_after(0)  # a run that died before its first checkpoint starts over, records too
         return trainer
@@ -337,8 +339,11 @@ class Trainer:
         tensorboard: bool = True,
         env_factory: Callable[[EnvConfig], Any] = RotoEnv,
         wandb_project: str | None = None,
+        *,
+        threads: int | None = None,
     ) -> Trainer:
-        """A trainer continuing ``run_dir`` from its latest checkpoint (optionally with a new step budget).
+        """A trainer continuing ``run_dir`` from its latest checkpoint (optionally with a new step
+        budget, and on ``threads`` C threads instead of the run's own).
 
         A run that logged to W&B continues its W&B run; ``wandb_project`` adds W&B to one that did not.
         """
@@ -360,6 +365,8 @@ class Trainer:
             )
         if total_steps is not None:
             settings = TrainSettings(env=settings.env, total_steps=total_steps)
+        if threads is not None:
+            settings = TrainSettings(env=settings.env_config(threads=threads), total_steps=settings.total_steps)
         wandb_project = logged_wandb_project(run_dir) or wandb_project
         trainer = cls(
             settings, agent, run_dir, tensorboard=tensorboard, env_factory=env_factory, wandb_project=wandb_project

@@ -112,7 +112,7 @@ def test_robot_in_an_override_becomes_each_cells_hand():
     for robot, variant, share in cells:
         spec = cell_spec(plan, Cell("baoding", robot, "blind", variant, 1))
         assert spec.env.replay_starts == f"benchmarks/results/baoding_reference/{robot}_preswap.npz"
-        assert spec.env.replay_share == share and spec.agent.ppo.epochs == 4 and spec.env.threads == 2
+        assert spec.env.replay_share == share and spec.agent.ppo.epochs == 4 and spec.env.threads == 1
     assert {(c.robot, c.variant) for c in plan.cells} == {
         ("shadow", "task_critic_replay"),
         *((robot, "task_critic_more_aids") for robot in ("shadow_lite", "allegro")),
@@ -213,7 +213,7 @@ def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(robot, v
     plan = load_plan("baoding_v1_cpu")
     cell = cell_spec(plan, Cell("baoding", robot, "blind", variant, 0))
     config = f"baoding_cpu_{robot}"
-    packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=2)
+    packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=1)
     assert packaged.differences(cell) == {} and packaged.env.replay_starts.endswith(f"{robot}_preswap.npz")
 
 

@@ -66,6 +66,25 @@ def test_resume_continues_bit_identically(tmp_path):
     )
 
 
+def test_a_run_continued_on_other_threads_trains_as_the_uninterrupted_run(tmp_path):
+    """C threads say how fast, not what: an Olympiad cell or a sweep trial may continue on fewer."""
+    from roto.rl.run_dir import RunDir
+    from roto.rl.run_spec import build_run_spec
+
+    def spec(updates, threads):
+        return build_run_spec("bounce", overrides=TINY, steps=16 * updates, num_envs=4, seed=3, threads=threads)
+
+    whole = Trainer.open(tmp_path / "whole", spec(3, 2), tensorboard=False)
+    whole.train(progress=False)
+    Trainer.open(tmp_path / "part", spec(2, 2), tensorboard=False).train(progress=False)
+    resumed = Trainer.open(tmp_path / "part", spec(3, 1), tensorboard=False)
+    assert resumed.update == 2 and resumed.settings.env.threads == 1
+    resumed.train(progress=False)
+    pw, pr = params(whole), params(resumed)
+    assert all(torch.equal(pw[k], pr[k]) for k in pw)
+    assert RunDir(tmp_path / "part").config()[0].env.threads == 1  # config.yaml says what it ran on last
+
+
 AGENT_V2 = [
     "ssl.forward_dynamics_memory={seq_length: 2, capacity: 40}",
     "ssl.forward_dynamics={seq_length: 3, max_sequences: 6}",
