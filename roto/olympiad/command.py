@@ -70,21 +70,29 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
 
 
 def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None) -> str:
-    """The cells and their status, and the time left at the throughput of the finished cells."""
+    """The cells and their status, and the time left at the throughput of the finished cells for
+    the env steps left (a started cell counts the env steps of its run's last evaluation)."""
     from roto.olympiad.results import read_summaries
     from roto.olympiad.worker import cell_status
+    from roto.rl.evaluation import read_evaluations
 
     status = cell_status(plan, root, results, storage)
     lines = [f"plan {plan.name}: {len(plan.cells)} cells, {plan.steps} env steps each", ""]
-    lines += [f"  {name:<52} {state}" for name, state in status.items()]
+    done_steps = {}
+    for name, state in status.items():
+        records = [] if state == "done" else read_evaluations(pathlib.Path(root) / plan.name / name)
+        done_steps[name] = min(int(records[-1]["env_steps"]), plan.steps) if records else 0
+        progress = f" ({done_steps[name] / 1e6:.1f} M env steps)" if done_steps[name] else ""
+        lines.append(f"  {name:<52} {state}{progress}")
     left = sum(state != "done" for state in status.values())
+    steps_left = sum(plan.steps - done_steps[name] for name, state in status.items() if state != "done")
     try:
         summaries = read_summaries(results)
     except FileNotFoundError:
         summaries = []
     if summaries:
         rate = sum(s["env_steps"] for s in summaries) / sum(s["train_wall_s"] for s in summaries)
-        hours = left * plan.steps / rate / 3600
+        hours = steps_left / rate / 3600
         estimate = f"{hours:.1f} h for one worker at {rate:.0f} env steps/s (the finished cells' throughput)"
     else:
         estimate = f"unknown: no finished cell's summary in {results} (--results names the folder)"

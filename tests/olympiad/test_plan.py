@@ -85,6 +85,14 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     # 15 cells left x 5 M steps at 5000 env steps/s = 15000 s
     assert "1 done, 15 left; time left: 4.2 h for one worker at 5000 env steps/s" in out
     assert not (tmp_path / "cpu").exists()  # a dry run creates no study
+    started = tmp_path / "cpu" / "bounce-allegro-blind-ppo-seed0"  # a cell's run, 2.5 M steps in
+    started.mkdir(parents=True)
+    (started / "evaluations.jsonl").write_text(json.dumps({"update": 610, "env_steps": 2_500_000}) + "\n")
+    assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
+    out = capsys.readouterr().out
+    assert "bounce-allegro-blind-ppo-seed0" in out and "(2.5 M env steps)" in out
+    assert "time left: 4.0 h for one worker" in out  # (75 M - 2.5 M) / 5000 env steps/s = 14500 s
+    assert sorted(p.name for p in (tmp_path / "cpu").iterdir()) == [started.name]  # still no study
     assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
     assert f"time left: unknown: no finished cell's summary in {tmp_path / 'none'}" in capsys.readouterr().out
 
