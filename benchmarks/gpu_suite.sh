@@ -17,9 +17,10 @@
 #   suite.log         one line per step: exit status and seconds
 # A short lease runs a subset, chosen by environment variables (defaults: everything):
 #   PAIRS="bounce:shadow"        the (task:robot) pairs benched (default all eight)
-#   SCALING="8192"               the env counts of the scaling line (default 1024 ... 32768; "" skips it)
+#   SCALING="8192"               the env counts of the scaling line (default 1024 ... 32768)
 #   PYTEST_FILES="tests/rl/..."  the GPU test files (default the three below)
 #   UPDATE_AGENTS="bounce bounce_cpu_quickstart"  agent configs whose update is timed (default bounce)
+#   (each of these four set to "" skips its step)
 #   DEADLINE=<epoch seconds>     training stops 60 s before it (room for the policies), whatever TRAIN_SECONDS says
 #   TRAIN_TASK=baoding TRAIN_ROBOT=shadow  what the training trains (default bounce, shadow)
 # Exits non-zero, naming the failed steps and the tail of their error output, if any step failed.
@@ -44,13 +45,15 @@ step() {  # step NAME STDOUT_FILE COMMAND...: run it, log status and time, remem
 
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv > "$out/gpu.txt" 2>&1 || failed+=(nvidia-smi)
 all_pairs="bounce:shadow bounce:shadow_lite bounce:allegro bounce:orca baoding:shadow baoding:shadow_lite baoding:allegro baoding:orca"
-read -r -a pytest_files <<< "${PYTEST_FILES:-tests/envs/test_sync_free_step.py tests/rl/test_training_gpu.py tests/rl/test_graphed_step.py}"
-step pytest_gpu "$out/pytest_gpu.txt" python3 -m pytest -q -m gpu -p no:cacheprovider "${pytest_files[@]}"
-for agent in ${UPDATE_AGENTS:-bounce}; do
+read -r -a pytest_files <<< "${PYTEST_FILES-tests/envs/test_sync_free_step.py tests/rl/test_training_gpu.py tests/rl/test_graphed_step.py}"
+if [ ${#pytest_files[@]} -gt 0 ]; then
+  step pytest_gpu "$out/pytest_gpu.txt" python3 -m pytest -q -m gpu -p no:cacheprovider "${pytest_files[@]}"
+fi
+for agent in ${UPDATE_AGENTS-bounce}; do
   step "update_cost_$agent" "$out/update_cost.jsonl" python3 benchmarks/update_cost.py --device cuda \
     --num_envs "$num_envs" --agent_cfg "$agent"
 done
-for pair in ${PAIRS:-$all_pairs}; do
+for pair in ${PAIRS-$all_pairs}; do
   task=${pair%%:*} robot=${pair#*:}
   step "bench_${task}_${robot}" "$out/bench_warp.jsonl" python3 -m roto.cli bench --backend warp --device cuda \
     --task "$task" --robot "$robot" --num_envs "$num_envs" --steps 200 --json
@@ -88,4 +91,4 @@ if [ ${#failed[@]} -gt 0 ]; then
   done
   exit 1
 fi
-echo "gpu suite: every step passed ($(wc -l < "$out/bench_warp.jsonl") bench lines)"
+echo "gpu suite: every step passed ($(cat "$out/bench_warp.jsonl" 2>/dev/null | wc -l) bench lines)"
