@@ -7,11 +7,13 @@ with made-up observations and rewards (no simulation: this isolates the update),
 ``update()`` per variant, one JSON line each: the median seconds per update over the updates after
 the first (the first compiles, captures and warms up) and the samples per second that makes.
 A variant is a set of the update's speed settings (``--variants``, default: all but
-``eager_fused`` on a CUDA device, ``eager`` and ``eager_fused`` on the CPU): ``cuda_graph``
+``eager_fused`` and ``eager_bf16`` on a CUDA device; ``eager``, ``eager_fused`` and ``eager_bf16``
+on the CPU): ``cuda_graph``
 replays each minibatch step from a CUDA graph (``ppo.cuda_graph=true``), ``fused`` steps Adam
 with the fused implementation
 (``ppo.fused_adam=true``), ``tf32`` lets the update's matrix products use TF32
-(``ppo.tf32_update=true``); ``eager`` is none of them.
+(``ppo.tf32_update=true``), ``bf16`` runs the update's forward and backward passes under bfloat16
+autocast (``ppo.bf16_update=true``); ``eager`` is none of them.
 """
 
 from __future__ import annotations
@@ -45,19 +47,20 @@ def fill(alg: PPO, sizes: dict[str, int], generator: torch.Generator) -> None:
     alg.compute_returns(obs())
 
 
-GRAPH, FUSED, TF32 = "ppo.cuda_graph=true", "ppo.fused_adam=true", "ppo.tf32_update=true"
+GRAPH, FUSED, TF32, BF16 = "ppo.cuda_graph=true", "ppo.fused_adam=true", "ppo.tf32_update=true", "ppo.bf16_update=true"
 VARIANTS = {
     "eager": [],
     "eager_fused": [FUSED],
     "eager_tf32": [TF32],
+    "eager_bf16": [BF16],
     "cuda_graph": [GRAPH],
     "cuda_graph_tf32": [GRAPH, TF32],
     "cuda_graph_fused": [GRAPH, FUSED],
     "cuda_graph_fused_tf32": [GRAPH, FUSED, TF32],
 }
 """Variant name -> the agent-config overrides it times."""
-CPU_VARIANTS = ("eager", "eager_fused")
-GPU_VARIANTS = tuple(name for name in VARIANTS if name != "eager_fused")
+CPU_VARIANTS = ("eager", "eager_fused", "eager_bf16")
+GPU_VARIANTS = tuple(name for name in VARIANTS if name not in ("eager_fused", "eager_bf16"))
 
 
 def measure(args: argparse.Namespace, variant: str) -> dict[str, object]:

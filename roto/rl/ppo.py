@@ -191,7 +191,7 @@ class PPO:
     def _minibatch_step(self, batch: dict, aux: list[tuple[AuxLoss, Any]]) -> dict[str, torch.Tensor]:
         """One backward of the weighted loss terms, PPO's Adam step, then each active loss's own step."""
         c = self.config
-        mean, log_std, value, latent = self.model(batch["obs"])
+        mean, log_std, value, latent = self._forward(batch["obs"])
         dist = torch.distributions.Normal(mean, log_std.exp().expand_as(mean), validate_args=False)
         terms, diagnostics = ppo_terms(
             dist.log_prob(batch["actions"]).sum(-1),
@@ -224,6 +224,15 @@ class PPO:
         metrics.update({f"loss/{name}": value_.detach() for name, value_ in terms.items()})
         metrics["loss/total"] = total.detach()
         return metrics
+
+    def _forward(self, obs: Obs) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """The model's outputs for the update, in FP32; under bfloat16 autocast with ``bf16_update``."""
+        if not self.config.bf16_update:
+            return self.model(obs)
+        device_type = self.storage.values.device.type
+        with torch.autocast(device_type=device_type, dtype=torch.bfloat16):
+            mean, log_std, value, latent = self.model(obs)
+        return mean.float(), log_std.float(), value.float(), latent.float()
 
     def _adapt_lr(self, kl: float) -> None:
         c = self.config
