@@ -32,8 +32,10 @@ def explained_variance(prediction: torch.Tensor, target: torch.Tensor) -> torch.
 
 
 def check_graphable(config: PPOConfig, storage: RolloutBuffer, aux_losses: list[AuxLoss]) -> None:
-    """Raise ValueError unless ``ppo.cuda_graph`` can run: no auxiliary losses, minibatches of one
-    size, a CUDA device."""
+    """Raise ValueError unless ``ppo.cuda_graph`` can run: no auxiliary losses, no bfloat16 update,
+    minibatches of one size, a CUDA device."""
+    if config.bf16_update:
+        raise ValueError("ppo.cuda_graph=true does not graph the bfloat16 update yet; set ppo.bf16_update=false")
     if aux_losses:
         names = [aux.name for aux in aux_losses]
         raise ValueError(f"ppo.cuda_graph=true does not graph auxiliary losses yet; set it false or drop ssl: {names}")
@@ -162,6 +164,8 @@ class PPO:
 
     def _update(self) -> dict[str, float]:
         c, buffer = self.config, self.storage
+        if c.bf16_update:
+            self._rescore_log_probs()
         aux_batches = {aux.name: aux.prepare(buffer, c.minibatches, self.generator) for aux in self.aux_losses}
         sums: dict[str, torch.Tensor] = {}
         counts: dict[str, int] = {}
@@ -224,6 +228,20 @@ class PPO:
         metrics.update({f"loss/{name}": value_.detach() for name, value_ in terms.items()})
         metrics["loss/total"] = total.detach()
         return metrics
+
+    @torch.no_grad()
+    def _rescore_log_probs(self) -> None:
+        """The rollout's log-probabilities under the update's own bfloat16 forward pass.
+
+        The rollout scored its actions in FP32; the same weights in bfloat16 give means rounded to 8
+        significant bits, and the log-ratio error (about the rounding over the std, summed over the
+        action dimensions) would exceed the clip once the policy's std is small. Scoring the old
+        policy with the forward the update uses makes every ratio start at 1.
+        """
+        buffer = self.storage
+        mean, log_std, _, _ = self._forward(buffer.flat_obs())
+        dist = torch.distributions.Normal(mean, log_std.exp().expand_as(mean), validate_args=False)
+        buffer.log_probs.copy_(dist.log_prob(buffer.actions.flatten(0, 1)).sum(-1).view_as(buffer.log_probs))
 
     def _forward(self, obs: Obs) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
         """The model's outputs for the update, in FP32; under bfloat16 autocast with ``bf16_update``."""
