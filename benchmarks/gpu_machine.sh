@@ -4,8 +4,8 @@
 # kernel cache to /tmp/wc; afterwards every command needs
 #   export PYTHONPATH=/tmp/site:$PWD ROTO_WARP_CACHE=/tmp/wc
 #
-#   bash benchmarks/gpu_machine.sh stage DIR    copy DIR's files (one part of benchmarks/gpu_wheels.sh,
-#                                               carried by one transfer) into /tmp/whl
+#   bash benchmarks/gpu_machine.sh stage DIR    copy DIR's files, not its folders (one part of
+#                                               benchmarks/gpu_wheels.sh, carried by one transfer) into /tmp/whl
 #   bash benchmarks/gpu_machine.sh install [DIR]  stage DIR if given, then unpack Warp and install the
 #                                               wheels staged so far into /tmp/site; unpack the kernel
 #                                               caches staged so far (kernels*.tar.xz.part-NN, from `pack`,
@@ -14,14 +14,15 @@
 #                                               checkpoints or TensorBoard events, and the kernel cache into
 #                                               $OUT/kernels.tar.xz.part-NN of 15 MiB each (what a call brings
 #                                               back is limited to 16 MiB a file)
-# Here, the parts that came back join into one archive that a later sitting carries and stages:
-#   cat kernels.tar.xz.part-* > .cache/warp_cuda_sm90.tar.xz
+# Here, the parts that came back go into a folder of their own that git ignores (like the wheel
+# parts' .whl1 ...), which a later sitting carries and stages in one more call:
+#   mkdir -p .whl_kernels && cp kernels.tar.xz.part-* .whl_kernels/
 set -euo pipefail
 whl=/tmp/whl site=/tmp/site cache_parent=/tmp
 
 stage() {
   mkdir -p "$whl"
-  cp "${1:?usage: gpu_machine.sh stage DIR}"/* "$whl"/
+  find "${1:?usage: gpu_machine.sh stage DIR}" -maxdepth 1 -type f -exec cp -t "$whl" {} +
 }
 
 install() {

@@ -103,11 +103,12 @@ class PPOConfig:
     """Let the update's matrix products on a CUDA device use TF32 (10-bit mantissa inputs, FP32
     accumulation; torch.backends.cuda.matmul.allow_tf32) for its duration. No effect on a CPU."""
     bf16_update: bool = False
-    """Run the update's forward and backward passes under bfloat16 autocast (matrix products with
-    8-bit mantissa inputs, FP32 accumulation); weights, Adam's state, the action distribution and
-    the losses stay FP32, and the rollout's inference is untouched. About 2x faster updates on a
-    CPU with AMX (recent Intel Xeons), slower on CPUs without bfloat16 instructions; in a one-seed
-    Bounce pair its policy was less steady than FP32's (docs/training.md)."""
+    """Run PPO's forward and backward passes in the update under bfloat16 autocast (matrix products
+    with 7-bit mantissa inputs and outputs, FP32 accumulation), the rollout's actions rescored with
+    that forward so that every ratio starts at 1; weights, Adam's state, the action distribution,
+    the losses and auxiliary losses' own passes stay FP32, and rollouts are untouched. About 2x
+    faster updates on a CPU with AMX (recent Intel Xeons), slower on CPUs without bfloat16
+    instructions (docs/training.md). Not with ``cuda_graph``."""
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # The GPU sitting of 2026-11-26, its last call: install the packages, then blind Shadow Bounce at
 # 8192 envs with the CPU-tuned coefficients (bounce_cpu_quickstart) and the CUDA-graph update, as
-# long as the lease allows. The two calls before it copied .whl1/* and .whl2/* into /tmp/whl.
+# long as the lease allows. The two calls before it copied .whl1/* and .whl2/* into /tmp/whl:
+# .whl1 ... .whl3 are the git-ignored parts that benchmarks/gpu_wheels.sh writes, .whl3 also holding
+# the kernel-cache archive warp_cuda_h100_bounce_shadow.tar.xz (benchmarks/gpu_machine.sh now does
+# these steps for any sitting).
 #   usage (on the GPU machine, in the repo root): BUDGET_S=560 bash benchmarks/results/gpu_h200_2026-11-26/sitting.sh
 # Everything lands in $OUT/sitting.tgz (the suite's files, the run without its full checkpoints).
 set -u
