@@ -86,6 +86,23 @@ def test_warp_follows_the_cpu_backend_on_every_pair(task, robot):
     assert_parity(task, robot, "hold" if robot in BOX_FINGERS else "smooth")
 
 
+def test_the_critics_groups_follow_the_cpu_backend():
+    """What a Baoding critic reads beside the policy (the balls' state, the targets, latches and
+    time left) is the same on both backends: the GPU recipe's critic sees what the CPU's saw."""
+    groups = ("privileged", "task")
+    cpu = roto.make("baoding", robot="shadow", num_envs=3, seed=0, extra_groups=groups)
+    warp = roto.make("baoding", robot="shadow", num_envs=3, seed=0, backend="warp", extra_groups=groups)
+    observations = [(cpu.reset()[0], warp.reset()[0])]
+    for action in smooth_actions(PARITY_STEPS, 3, cpu.num_actions):
+        observations.append((cpu.step(action)[0], warp.step(action)[0]))
+    for obs_cpu, obs_warp in observations:
+        assert torch.allclose(obs_cpu["privileged"], obs_warp["privileged"], atol=1e-3)
+        assert torch.allclose(obs_cpu["task"], obs_warp["task"], atol=1e-6)
+    assert observations[-1][0]["task"].abs().sum() > 0  # the group carries something to compare
+    cpu.close()
+    warp.close()
+
+
 @pytest.mark.parametrize("name", ["allegro", "shadow"])
 def test_ball_on_palm_gives_identical_bits_on_both_backends(name):
     robot = get_robot(name)
