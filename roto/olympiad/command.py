@@ -49,7 +49,9 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     plan = load_plan(args.plan)  # checked before anything runs or is written
     results = _results_dir(args, plan.name)
     if args.dry_run:
-        print(dry_run_report(plan, args.root, results, args.storage))
+        if args.workers < 1:
+            raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        print(dry_run_report(plan, args.root, results, args.storage, args.workers))
         return 0
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
@@ -69,34 +71,61 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     return 0
 
 
-def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None) -> str:
+def busiest_worker_steps(steps_left: list[int], workers: int) -> int:
+    """Env steps of the busiest of ``workers`` workers when the cells go, largest first, each to the
+    least loaded worker (a cell is never split between workers)."""
+    loads = [0] * workers
+    for steps in sorted(steps_left, reverse=True):
+        loads[loads.index(min(loads))] += steps
+    return max(loads)
+
+
+def recent_rate(records: list[dict]) -> float | None:
+    """Training env steps per second between a run's last two evaluations (None without two)."""
+    if len(records) < 2 or "train_wall_s" not in records[-1] or "train_wall_s" not in records[-2]:
+        return None
+    seconds = records[-1]["train_wall_s"] - records[-2]["train_wall_s"]
+    return (records[-1]["env_steps"] - records[-2]["env_steps"]) / seconds if seconds > 0 else None
+
+
+def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1) -> str:
     """The cells and their status, and the time left at the throughput of the finished cells for
-    the env steps left (a started cell counts the env steps of its run's last evaluation)."""
+    the env steps left (a started cell counts the env steps of its run's last evaluation); with
+    several workers, also the time until the busiest one is done, each at the running cells'
+    current throughput."""
     from roto.olympiad.results import read_summaries
     from roto.olympiad.worker import cell_status
     from roto.rl.evaluation import read_evaluations
 
     status = cell_status(plan, root, results, storage)
     lines = [f"plan {plan.name}: {len(plan.cells)} cells, {plan.steps} env steps each", ""]
-    done_steps = {}
+    done_steps, running_rates = {}, []
     for name, state in status.items():
         records = [] if state == "done" else read_evaluations(pathlib.Path(root) / plan.name / name)
         done_steps[name] = min(int(records[-1]["env_steps"]), plan.steps) if records else 0
+        if state == "running" and recent_rate(records):
+            running_rates.append(recent_rate(records))
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps)" if done_steps[name] else ""
         lines.append(f"  {name:<52} {state}{progress}")
     left = sum(state != "done" for state in status.values())
-    steps_left = sum(plan.steps - done_steps[name] for name, state in status.items() if state != "done")
+    cells_left = [plan.steps - done_steps[name] for name, state in status.items() if state != "done"]
     try:
         summaries = read_summaries(results)
     except FileNotFoundError:
         summaries = []
     if summaries:
         rate = sum(s["env_steps"] for s in summaries) / sum(s["train_wall_s"] for s in summaries)
-        hours = steps_left / rate / 3600
+        hours = sum(cells_left) / rate / 3600
         estimate = f"{hours:.1f} h for one worker at {rate:.0f} env steps/s (the finished cells' throughput)"
     else:
+        rate = None
         estimate = f"unknown: no finished cell's summary in {results} (--results names the folder)"
     lines += ["", f"{len(status) - left} done, {left} left; time left: {estimate}"]
+    if workers > 1 and (running_rates or rate):
+        each = sum(running_rates) / len(running_rates) if running_rates else rate
+        source = "the running cells' last evaluation rounds" if running_rates else "the finished cells' throughput"
+        hours = busiest_worker_steps(cells_left, workers) / each / 3600
+        lines.append(f"with {workers} workers at {each:.0f} env steps/s each ({source}): {hours:.1f} h")
     return "\n".join(lines)
 
 

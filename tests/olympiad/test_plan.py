@@ -92,6 +92,10 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     out = capsys.readouterr().out
     assert "bounce-allegro-blind-ppo-seed0" in out and "(2.5 M env steps)" in out
     assert "time left: 4.0 h for one worker" in out  # (75 M - 2.5 M) / 5000 env steps/s = 14500 s
+    assert main(["olympiad", "cpu", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
+                 str(results)]) == 0  # fmt: skip
+    # 14 cells of 5 M and one of 2.5 M over two workers: 37.5 M on the busier one = 7500 s
+    assert "with 2 workers at 5000 env steps/s each (the finished cells' throughput): 2.1 h" in capsys.readouterr().out
     assert sorted(p.name for p in (tmp_path / "cpu").iterdir()) == [started.name]  # still no study
     assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
     assert f"time left: unknown: no finished cell's summary in {tmp_path / 'none'}" in capsys.readouterr().out
@@ -234,3 +238,14 @@ def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_st
     bank = "benchmarks/results/baoding_reference/allegro_cycle.npz"
     assert cycle.differences(low) == {"env.replay_starts": (bank, bank.replace("cycle", "preswap"))}
     assert pathlib.Path(bank).is_file()
+
+
+def test_the_busiest_worker_and_a_running_cells_rate():
+    from roto.olympiad.command import busiest_worker_steps, recent_rate
+
+    assert busiest_worker_steps([5, 5, 5], 2) == 10  # cells are never split
+    assert busiest_worker_steps([7, 4, 3, 3], 2) == 10  # largest first: 7+3 and 4+3
+    assert busiest_worker_steps([4], 3) == 4
+    records = [{"env_steps": 1000, "train_wall_s": 10.0}, {"env_steps": 4000, "train_wall_s": 12.0}]
+    assert recent_rate(records) == 1500.0
+    assert recent_rate(records[:1]) is None and recent_rate([{"env_steps": 1}, {"env_steps": 2}]) is None
