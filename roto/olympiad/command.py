@@ -103,8 +103,9 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
     for name, state in status.items():
         records = [] if state == "done" else read_evaluations(pathlib.Path(root) / plan.name / name)
         done_steps[name] = min(int(records[-1]["env_steps"]), plan.steps) if records else 0
-        if state == "running" and recent_rate(records):
-            running_rates.append(recent_rate(records))
+        rate_now = recent_rate(records) if state == "running" else None
+        if rate_now:
+            running_rates.append(rate_now)
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps)" if done_steps[name] else ""
         lines.append(f"  {name:<52} {state}{progress}")
     left = sum(state != "done" for state in status.values())
