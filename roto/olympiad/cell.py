@@ -2,14 +2,16 @@
 
 The run directory is ``<root>/<plan>/<cell>`` (an ordinary run: ``roto eval``, ``roto play`` and
 ``roto train --resume`` work on it); a cell whose run has a checkpoint continues from it. The
-summary, ``<results>/<cell>.json``, is small enough to commit: the evaluation curve, the final and
-best policies' evaluations over the plan's episodes (per-episode returns and task metrics
-included), the training wall time and the commit. ``roto results`` reads only summaries, so
+summary, ``<results>/<cell>.json``, is small enough to commit: the evaluation curve, the training
+scalars between evaluations (the policy's action std, the training episodes' return, length and
+task metrics), the final and best policies' evaluations over the plan's episodes (per-episode
+returns and task metrics included), the training wall time and the commit. ``roto results`` reads only summaries, so
 cells trained on other machines or in other sittings combine.
 """
 
 from __future__ import annotations
 
+import bisect
 import copy
 import json
 import pathlib
@@ -24,7 +26,7 @@ from roto.olympiad.plan import Cell, Plan
 from roto.result_files import write_text_atomic
 from roto.rl.checkpoints import load_checkpoint
 from roto.rl.evaluation import read_evaluations
-from roto.rl.run_dir import RunDir
+from roto.rl.run_dir import RunDir, read_scalars
 from roto.rl.run_lock import wait_until_free
 from roto.rl.run_spec import RunSpec, build_run_spec
 from roto.rl.runner import Trainer
@@ -35,6 +37,27 @@ def code_commit() -> str:
     """The checked-out commit (short hash), or "unknown" outside a git checkout."""
     out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=False)
     return out.stdout.strip() or "unknown"
+
+
+TRAINING_SCALARS = ("ppo/action_std",)  # besides every ``train/...`` scalar (the training episodes')
+
+
+def training_curve(scalars: dict[str, tuple[list[int], list[float]]], env_steps: list[int]) -> list[dict[str, float]]:
+    """For each of ``env_steps`` (ascending: the evaluations'), the mean of the policy's action std
+    and of every ``train/...`` scalar over the updates logged after the previous one and up to it
+    (a tag with no update there is left out). ``scalars``: {tag: (env_steps, values)}, ascending."""
+    tags = sorted(tag for tag in scalars if tag in TRAINING_SCALARS or tag.startswith("train/"))
+    rows, previous = [], -1
+    for step in env_steps:
+        row: dict[str, float] = {"env_steps": step}
+        for tag in tags:
+            steps, values = scalars[tag]
+            window = values[bisect.bisect_right(steps, previous) : bisect.bisect_right(steps, step)]
+            if window:
+                row[tag] = sum(window) / len(window)
+        rows.append(row)
+        previous = step
+    return rows
 
 
 def summary_path(results: pathlib.Path, cell: Cell) -> pathlib.Path:
@@ -83,6 +106,7 @@ def run_cell(
         "train_wall_s": trainer.train_seconds,
         "best_update": max(records, key=lambda r: r["return_mean"])["update"],
         "evaluations": [{k: v for k, v in r.items() if k != "per_episode"} for r in records],
+        "training": training_curve(read_scalars(run_dir), [r["env_steps"] for r in records]),
         "final": evaluate(final, trainer.settings, plan.eval_episodes, env_factory=env_factory),
         "best": evaluate(best, trainer.settings, plan.eval_episodes, env_factory=env_factory),
     }

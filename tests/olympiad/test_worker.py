@@ -42,6 +42,8 @@ def test_two_workers_finish_every_cell_once(tmp_path):
         assert summary["evaluations"] == [
             {k: v for k, v in r.items() if k != "per_episode"} for r in read_evaluations(root / plan.name / cell.name)
         ]
+        assert [row["env_steps"] for row in summary["training"]] == [r["env_steps"] for r in summary["evaluations"]]
+        assert all(row["ppo/action_std"] > 0 for row in summary["training"])
     assert set(cell_status(plan, str(root), results, None).values()) == {"done"}
     # rerunning skips finished cells, with the journal or (another sitting) from the summaries alone
     assert toy_worker(plan_path, root) == 0
