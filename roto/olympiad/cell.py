@@ -5,8 +5,8 @@ The run directory is ``<root>/<plan>/<cell>`` (an ordinary run: ``roto eval``, `
 summary, ``<results>/<cell>.json``, is small enough to commit: the evaluation curve, the training
 scalars between evaluations (the policy's action std, the training episodes' return, length and
 task metrics), the final and best policies' evaluations over the plan's episodes (per-episode
-returns and task metrics included), the training wall time and the commit. ``roto results`` reads only summaries, so
-cells trained on other machines or in other sittings combine.
+returns and task metrics included), the training wall time and the commit. ``roto results`` reads
+only summaries, so cells trained on other machines or in other sittings combine.
 """
 
 from __future__ import annotations
