@@ -58,12 +58,13 @@ def plot_variants(
     out: str | pathlib.Path,
     title: str = "",
     xs: Sequence[str] = ("env_steps",),
+    ylabel: str = "",
 ) -> pathlib.Path:
     """Evaluation ``metric`` against each of ``xs`` (record keys: ``env_steps``, ``train_wall_s``),
     one panel each: per variant, the mean over its runs (seeds) with a band from the lowest to the
     highest run. ``runs`` maps each variant to the evaluation records of each of its runs
     (``read_evaluations``); runs are cut to the evaluations they all have, and an x value is the
-    mean over the runs at that evaluation."""
+    mean over the runs at that evaluation. ``ylabel`` replaces the axis label "evaluation <metric>"."""
     plt = _pyplot()
     fig, axes = plt.subplots(1, len(xs), figsize=(7 * len(xs), 4.2), squeeze=False)
     for ax, x in zip(axes[0], xs, strict=True):
@@ -77,7 +78,7 @@ def plot_variants(
             (line,) = ax.plot(position, values.mean(axis=0), label=f"{variant} ({seeds})")
             ax.fill_between(position, values.min(axis=0), values.max(axis=0), color=line.get_color(), alpha=0.15)
         ax.set_xlabel({"env_steps": "env steps", "train_wall_s": "training wall time (s)"}.get(x, x))
-        ax.set_ylabel(f"evaluation {metric} (mean over seeds)")
+        ax.set_ylabel(ylabel or f"evaluation {metric} (mean over seeds)")
         ax.grid(alpha=0.3)
         ax.legend(loc="upper left")
     if title:  # one title over the panels, wrapped to their width (a long list of commits would overlap)

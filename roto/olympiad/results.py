@@ -168,6 +168,24 @@ def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pa
         path = out / f"curves_{task}_{robot}.png"
         plot_variants(curves, metric(task), path, title=f"{task} / {robot} ({label})", xs=("env_steps", "train_wall_s"))
         paths.append(path)
+    return paths + plot_action_std(summaries, out, label)
+
+
+def plot_action_std(summaries: list[dict], out: pathlib.Path, label: str) -> list[pathlib.Path]:
+    """Per (task, robot) whose summaries keep their training scalars (``training``): the policy's
+    action std in training against env steps, one line per (obs mode, variant)."""
+    groups: dict[tuple[str, str], dict[str, list]] = {}
+    for s in sorted(summaries, key=lambda s: (s["task"], s["robot"], s["obs"], s["variant"], s["seed"])):
+        rows = [{"env_steps": r["env_steps"], "action_std_mean": r["ppo/action_std"]}
+                for r in s.get("training", []) if "ppo/action_std" in r]  # fmt: skip
+        if rows:
+            groups.setdefault((s["task"], s["robot"]), {}).setdefault(f"{s['obs']} / {s['variant']}", []).append(rows)
+    paths = []
+    for (task, robot), curves in groups.items():
+        path = out / f"action_std_{task}_{robot}.png"
+        plot_variants(curves, "action_std", path, title=f"{task} / {robot} ({label})",
+                      ylabel="policy's action std in training (mean over seeds)")  # fmt: skip
+        paths.append(path)
     return paths
 
 

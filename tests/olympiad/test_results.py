@@ -26,6 +26,8 @@ def write_summaries(folder):
                    "commit": "abc1234", "env_steps": 2000, "train_wall_s": 4.0, "evaluations": curve,
                    "final": {f"{metric}_mean": final}, "best": {f"{metric}_mean": best},
                    "agent": AGENTS[variant], "task_version": {"bounce": 0, "baoding": 1}[task]}  # fmt: skip
+        if task == "baoding":  # a summary that keeps its training scalars (older ones do not)
+            summary["training"] = [{"env_steps": 1000 * u, "ppo/action_std": 1.0 + u} for u in (1, 2)]
         (folder / f"{task}-{robot}-blind-{variant}-seed{seed}.json").write_text(json.dumps(summary))
 
 
@@ -52,6 +54,9 @@ def test_results_match_hand_computed_statistics(tmp_path, capsys):
     # P(fd > ppo) on Shadow Bounce: 25 beats 10 and 20, 35 beats 10, 20 and 30: 5 of 8 pairs
     assert "bounce / shadow / blind: P(fd > ppo) = 0.62" in md
     assert (out / "curves_bounce_shadow.png").stat().st_size > 0 and (out / "curves_baoding_allegro.png").is_file()
+    # the action std plotted only where summaries keep it
+    assert (out / "action_std_baoding_allegro.png").stat().st_size > 0
+    assert not (out / "action_std_bounce_shadow.png").exists()
 
 
 def test_results_of_a_folder_without_summaries_is_a_clear_error(tmp_path, capsys):
