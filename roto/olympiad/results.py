@@ -14,7 +14,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import pathlib
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -156,32 +156,37 @@ def write_csv(scores: dict[Key, np.ndarray], path: pathlib.Path, policy: str) ->
                              s["iqm_low"], s["iqm_high"], " ".join(f"{v:.4g}" for v in runs)])  # fmt: skip
 
 
-def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pathlib.Path]:
-    """Per (task, robot): evaluation metric against env steps and training wall time, mean over
-    seeds with a min-max band, one line per (obs mode, variant)."""
+Curves = dict[tuple[str, str], dict[str, list]]  # {(task, robot): {"obs / variant": [records of each seed]}}
+
+
+def curves_by_pair(summaries: list[dict], records: Callable[[dict], list[dict]]) -> Curves:
+    """{(task, robot): {"obs / variant": [records(summary) of each seed]}}, seeds in order; a
+    summary whose ``records`` are empty is left out."""
     groups: dict[tuple[str, str], dict[str, list]] = {}
     for s in sorted(summaries, key=lambda s: (s["task"], s["robot"], s["obs"], s["variant"], s["seed"])):
-        curves = groups.setdefault((s["task"], s["robot"]), {})
-        curves.setdefault(f"{s['obs']} / {s['variant']}", []).append(s["evaluations"])
+        rows = records(s)
+        if rows:
+            groups.setdefault((s["task"], s["robot"]), {}).setdefault(f"{s['obs']} / {s['variant']}", []).append(rows)
+    return groups
+
+
+def action_std_records(summary: dict) -> list[dict]:
+    """The policy's action std in training at each evaluation (``training``; empty in summaries
+    written before they kept it), as records ``plot_variants`` reads."""
+    return [{"env_steps": r["env_steps"], "action_std_mean": r["ppo/action_std"]}
+            for r in summary.get("training", []) if "ppo/action_std" in r]  # fmt: skip
+
+
+def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pathlib.Path]:
+    """Per (task, robot): evaluation metric against env steps and training wall time, mean over
+    seeds with a min-max band, one line per (obs mode, variant); and, where summaries keep it,
+    the policy's action std in training against env steps (``action_std_<task>_<robot>.png``)."""
     paths = []
-    for (task, robot), curves in groups.items():
+    for (task, robot), curves in curves_by_pair(summaries, lambda s: s["evaluations"]).items():
         path = out / f"curves_{task}_{robot}.png"
         plot_variants(curves, metric(task), path, title=f"{task} / {robot} ({label})", xs=("env_steps", "train_wall_s"))
         paths.append(path)
-    return paths + plot_action_std(summaries, out, label)
-
-
-def plot_action_std(summaries: list[dict], out: pathlib.Path, label: str) -> list[pathlib.Path]:
-    """Per (task, robot) whose summaries keep their training scalars (``training``): the policy's
-    action std in training against env steps, one line per (obs mode, variant)."""
-    groups: dict[tuple[str, str], dict[str, list]] = {}
-    for s in sorted(summaries, key=lambda s: (s["task"], s["robot"], s["obs"], s["variant"], s["seed"])):
-        rows = [{"env_steps": r["env_steps"], "action_std_mean": r["ppo/action_std"]}
-                for r in s.get("training", []) if "ppo/action_std" in r]  # fmt: skip
-        if rows:
-            groups.setdefault((s["task"], s["robot"]), {}).setdefault(f"{s['obs']} / {s['variant']}", []).append(rows)
-    paths = []
-    for (task, robot), curves in groups.items():
+    for (task, robot), curves in curves_by_pair(summaries, action_std_records).items():
         path = out / f"action_std_{task}_{robot}.png"
         plot_variants(curves, "action_std", path, title=f"{task} / {robot} ({label})",
                       ylabel="policy's action std in training (mean over seeds)")  # fmt: skip
