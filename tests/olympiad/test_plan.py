@@ -14,6 +14,7 @@ def test_packaged_plans():
         "baoding_v1_cpu",
         "baoding_v1_ablations",
         "baoding_v1_more_aids",
+        "baoding_v1_shadow_more_aids",
     }
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
@@ -227,6 +228,24 @@ def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(robot, v
     config = f"baoding_cpu_{robot}"
     packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=1)
     assert packaged.differences(cell) == {} and packaged.env.replay_starts.endswith(f"{robot}_preswap.npz")
+
+
+def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_to_its_own():
+    """The Shadow's three-aid cell joins baoding_v1_cpu's column; it differs from its one-aid cell in the aids only."""
+    from roto.olympiad.cell import cell_spec
+
+    plan, main = load_plan("baoding_v1_shadow_more_aids"), load_plan("baoding_v1_cpu")
+    assert [c.name for c in plan.cells] == ["baoding-shadow-blind-task_critic_more_aids-seed1"]
+    variant = "task_critic_more_aids"
+    assert plan.variants[variant] == main.variants[variant] and (plan.steps, plan.threads) == (main.steps, main.threads)
+    three = cell_spec(plan, Cell("baoding", "shadow", "blind", variant, 1))
+    one = cell_spec(main, Cell("baoding", "shadow", "blind", "task_critic_replay", 1))
+    assert three.differences(one) == {
+        "env.replay_share": (0.5, 0.25),
+        "env.replay_record_lead": (10, 0),
+        "env.tolerance_start": (0.025, 0.0),
+        "env.tolerance_target": (2, 1.0),
+    }
 
 
 def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_starts():
