@@ -69,6 +69,7 @@ def build_model(sizes: Mapping[str, int], num_actions: int, agent: AgentConfig, 
         value_head=net.value_head,
         init_log_std=net.init_log_std,
         max_log_std=net.max_log_std,
+        project_log_std=net.project_log_std,
         obs_normalization=net.obs_normalization,
     )
 

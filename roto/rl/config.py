@@ -43,6 +43,11 @@ class NetworkConfig:
     """Upper bound of the policy's log standard deviation (roto's clamp: 2, a std of 7.4 in action
     units of ±1). A lower bound keeps a small batch's sampled actions near the mean action
     evaluation uses (0: a std of at most 1)."""
+    project_log_std: bool = False
+    """After each optimiser step, put the log-std parameter back inside [-20, max_log_std], so a
+    std at its bound keeps its gradient and can shrink again. False is roto's clamp in the forward
+    pass only: a parameter the entropy bonus pushes past the bound gets no gradient from then on,
+    and the std stays at the bound for the rest of the run."""
     obs_normalization: bool = True
     """Standardise each network's input with running statistics kept in the model (clip ±5)."""
     actor: tuple[str, ...] | None = None

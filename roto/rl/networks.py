@@ -80,6 +80,7 @@ class ActorCritic(nn.Module):
         policy_head, value_head: hidden sizes of the heads (Linear -> ELU), then a linear output.
         init_log_std: initial log standard deviation of every action dimension.
         max_log_std: upper bound of the log standard deviation (clamped in the forward pass).
+        project_log_std: ``after_optimizer_step`` puts the log-std parameter back inside its bounds.
         obs_normalization: standardise each encoder's input with running statistics kept here.
     """
 
@@ -95,6 +96,7 @@ class ActorCritic(nn.Module):
         value_head: Sequence[int] = (128, 64),
         init_log_std: float = 0.0,
         max_log_std: float = LOG_STD_MAX,
+        project_log_std: bool = False,
         obs_normalization: bool = True,
     ) -> None:
         super().__init__()
@@ -106,6 +108,7 @@ class ActorCritic(nn.Module):
         if not max_log_std > LOG_STD_MIN:
             raise ValueError(f"network.max_log_std must be above {LOG_STD_MIN}, got {max_log_std}")
         self.max_log_std = float(max_log_std)
+        self.project_log_std = bool(project_log_std)
         self.log_std = nn.Parameter(torch.full((num_actions,), float(init_log_std)))
         self.critic_input: GroupInput | None = None
         self.critic_encoder: nn.Sequential | None = None
@@ -140,6 +143,13 @@ class ActorCritic(nn.Module):
     def clamped_log_std(self) -> torch.Tensor:
         """(n,) the policy's log standard deviation within [LOG_STD_MIN, max_log_std]."""
         return self.log_std.clamp(LOG_STD_MIN, self.max_log_std)
+
+    @torch.no_grad()
+    def after_optimizer_step(self) -> None:
+        """With ``project_log_std``, the log-std parameter back inside [LOG_STD_MIN, max_log_std]: at
+        the bound the forward pass's clamp passes its gradient on, past it none."""
+        if self.project_log_std:
+            self.log_std.clamp_(LOG_STD_MIN, self.max_log_std)
 
     def forward(self, obs: Obs) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
         """(action mean (N, n), log-std (n,), value (N,), actor latent (N, W))."""

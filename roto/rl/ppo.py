@@ -222,6 +222,7 @@ class PPO:
         # the clip covers the actor-critic (encoder included), never the auxiliary heads
         metrics["ppo/grad_norm"] = nn.utils.clip_grad_norm_(self.model.parameters(), c.max_grad_norm)
         self.optimizer.step()
+        self.model.after_optimizer_step()
         for loss_fn, _ in aux:
             loss_fn.optimizer.step()
             loss_fn.after_step(self.model)

@@ -285,3 +285,15 @@ def test_a_worker_retrying_a_run_still_in_use_waits_until_it_is_free(tmp_path, c
     waiter.join(timeout=10)
     assert not waiter.is_alive()
     Trainer.resume(tmp_path / "run", total_steps=32, tensorboard=False).train(progress=False)  # free again
+
+
+def test_ppo_projects_the_log_std_after_each_step_only_when_asked(tmp_path):
+    """A large entropy bonus pushes the log std past its bound of 0: with ``network.project_log_std``
+    every update leaves it at the bound, without it the parameter ends above (roto's clamp)."""
+    bound = ["network.max_log_std=0.0", "ppo.entropy_coef=10.0"]
+    clamped = tiny_trainer(tmp_path, "clamped", 2, bound)
+    clamped.train(progress=False)
+    assert bool((clamped.model.log_std > 0).all())
+    projected = tiny_trainer(tmp_path, "projected", 2, [*bound, "network.project_log_std=true"])
+    projected.train(progress=False)
+    assert torch.equal(projected.model.log_std.detach(), torch.zeros_like(projected.model.log_std))
