@@ -5,10 +5,10 @@ or a database, as for sweeps, ``roto.sweep.storage``), its name in the trial's `
 attribute. A worker enqueues every cell that has neither a summary nor a live trial, then claims
 waiting trials until none is waiting or running. A worker that dies leaves its trial without a
 heartbeat; the next worker to look fails it and enqueues a retry, which continues the cell's run
-from its latest checkpoint and is claimed before any fresh cell (so interrupted cells finish
-first, and a partial grid is as complete as it can be). Should a cell be enqueued twice (workers
-starting at once), the trial with the higher number sees the other running or complete and ends
-as a duplicate: no cell trains twice.
+from its latest checkpoint and is claimed before any fresh cell, as is any cell whose run has a
+checkpoint (so interrupted cells finish first, and a partial grid is as complete as it can be).
+Should a cell be enqueued twice (workers starting at once), the trial with the higher number
+sees the other running or complete and ends as a duplicate: no cell trains twice.
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from optuna.trial import TrialState
 from roto.envs.roto_env import RotoEnv
 from roto.olympiad.cell import code_commit, run_cell, summary_path
 from roto.olympiad.plan import Cell, Plan
+from roto.rl.run_dir import checkpoint_path
 from roto.sweep.claims import run_claimed, tell_failed
 from roto.sweep.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 
@@ -67,14 +68,23 @@ def is_duplicate(study: optuna.Study, number: int, cell: str) -> bool:
     return any(t.number < number or t.state == TrialState.COMPLETE for t in others)
 
 
-def claim_next(study: optuna.Study, storage: optuna.storages.BaseStorage) -> optuna.Trial | None:
-    """Claim a waiting trial, retries before fresh cells and then by number; None when none waits.
+def claim_next(
+    study: optuna.Study, storage: optuna.storages.BaseStorage, started: Callable[[str], bool] = lambda cell: False
+) -> optuna.Trial | None:
+    """Claim a waiting trial: retries and cells that ``started`` (by name) before fresh cells, then
+    by number; None when none waits. A started cell's trial need not be a retry: Optuna's retries
+    of one trial run out after ``roto.sweep.storage.MAX_RETRY`` (3), and a cell reclaimed at the
+    end of every sitting is then enqueued afresh, at the back of the queue.
 
     As ``optuna.Study.ask`` claims one, but in this order: setting a waiting trial running is
     atomic in every storage, so two workers never claim the same trial.
     """
     waiting = study.get_trials(deepcopy=False, states=(TrialState.WAITING,))
-    for trial in sorted(waiting, key=lambda t: (RETRY_OF_ATTR not in t.system_attrs, t.number)):
+
+    def fresh(trial: optuna.trial.FrozenTrial) -> bool:
+        return RETRY_OF_ATTR not in trial.system_attrs and not started(trial.user_attrs.get(CELL_ATTR, ""))
+
+    for trial in sorted(waiting, key=lambda t: (fresh(t), t.number)):
         try:
             if storage.set_trial_state_values(trial._trial_id, TrialState.RUNNING):
                 return optuna.Trial(study, trial._trial_id)
@@ -98,13 +108,14 @@ def run_olympiad_worker(
     study, storage = open_olympiad(plan, root, storage_url)
     enqueue_missing(study, plan, results)
     cells = {cell.name: cell for cell in plan.cells}
+    root_dir = pathlib.Path(root) / plan.name
     commit = code_commit()  # the code this worker trains with, read before the checkout can move on
     if reclaim:
         reclaim_now(study, storage)
     finished, told = 0, set()
     while True:
         fail_stale_trials(study, storage, grace=4 * heartbeat)
-        trial = claim_next(study, storage)
+        trial = claim_next(study, storage, lambda name: name in cells and checkpoint_path(root_dir / name).is_file())
         if trial is None:
             if wait_for_running(study, heartbeat, told):  # a dead worker's cell comes back as a retry
                 continue
@@ -116,7 +127,7 @@ def run_olympiad_worker(
         if is_duplicate(study, trial.number, name):
             tell_failed(study, trial, f"duplicate: another trial has cell {name}")
             continue
-        run_dir = pathlib.Path(root) / plan.name / name
+        run_dir = root_dir / name
 
         def work(_: dict, cell: Cell = cells[name], run_dir: pathlib.Path = run_dir) -> float:
             summary = run_cell(plan, cell, run_dir, results, commit, env_factory)

@@ -80,6 +80,28 @@ def test_a_killed_workers_cell_is_resumed_from_its_checkpoint(tmp_path):
     assert steps == sorted(set(steps)) and len(steps) > killed_at and steps[-1] == plan.steps  # resumed
 
 
+def test_a_started_cell_is_claimed_before_fresh_cells_without_being_a_retry(tmp_path):
+    """A cell reclaimed at the end of more sittings than Optuna retries (3) is enqueued afresh, at the
+    back of the queue; its checkpoint still puts it first."""
+    from roto.olympiad.cell import cell_spec
+    from roto.rl.runner import Trainer
+    from tests.rl.toy_env import ToyEnv
+
+    plan = load_plan(str(write_toy_plan(tmp_path, updates=2, seeds=(0,))))
+    root, last = tmp_path / "runs", plan.cells[-1]
+    trainer = Trainer.open(root / plan.name / last.name, cell_spec(plan, last), env_factory=ToyEnv)
+    trainer.train(progress=False)  # a sitting that trained the plan's last cell only, then ended
+    plan_path = write_toy_plan(tmp_path, updates=4, seeds=(0,))  # a longer budget: every cell has work left
+
+    assert toy_worker(plan_path, root) == len(plan.cells)
+    trials = sorted(load_study(root, plan).trials, key=lambda t: t.datetime_start)
+    assert all(t.state == TrialState.COMPLETE and "failed_trial" not in t.system_attrs for t in trials)
+    assert trials[0].user_attrs[CELL_ATTR] == last.name
+    assert trials[0].number == max(t.number for t in trials)  # enqueued last, claimed first
+    steps = [r["env_steps"] for r in read_evaluations(root / plan.name / last.name)]
+    assert steps == sorted(set(steps)) and steps[-1] == 8 * 4 * 4  # continued, not restarted
+
+
 def test_a_waiting_cell_no_longer_in_the_plan_is_failed_with_its_name(tmp_path):
     plan_path = write_toy_plan(tmp_path, seeds=(0,))
     plan, root = load_plan(str(plan_path)), tmp_path / "runs"
