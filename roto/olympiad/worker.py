@@ -6,7 +6,8 @@ attribute. A worker enqueues every cell that has neither a summary nor a live tr
 waiting trials until none is waiting or running. A worker that dies leaves its trial without a
 heartbeat; the next worker to look fails it and enqueues a retry, which continues the cell's run
 from its latest checkpoint and is claimed before any fresh cell, as is any cell whose run has a
-checkpoint (so interrupted cells finish first, and a partial grid is as complete as it can be).
+checkpoint, the most trained first (so interrupted cells finish first, and a partial grid is as
+complete as it can be).
 Should a cell be enqueued twice (workers starting at once), the trial with the higher number
 sees the other running or complete and ends as a duplicate: no cell trains twice.
 """
@@ -24,6 +25,7 @@ from optuna.trial import TrialState
 from roto.envs.roto_env import RotoEnv
 from roto.olympiad.cell import code_commit, run_cell, summary_path
 from roto.olympiad.plan import Cell, Plan
+from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import checkpoint_path
 from roto.sweep.claims import run_claimed, tell_failed
 from roto.sweep.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
@@ -69,28 +71,40 @@ def is_duplicate(study: optuna.Study, number: int, cell: str) -> bool:
 
 
 def claim_next(
-    study: optuna.Study, storage: optuna.storages.BaseStorage, started: Callable[[str], bool] = lambda cell: False
+    study: optuna.Study,
+    storage: optuna.storages.BaseStorage,
+    trained: Callable[[str], int | None] = lambda cell: None,
 ) -> optuna.Trial | None:
-    """Claim a waiting trial: retries and cells that ``started`` (by name) before fresh cells, then
-    by number; None when none waits. A started cell's trial need not be a retry: Optuna's retries
-    of one trial run out after ``roto.sweep.storage.MAX_RETRY`` (3), and a cell reclaimed at the
-    end of every sitting is then enqueued afresh, at the back of the queue.
+    """Claim a waiting trial: retries and started cells before fresh ones, the most trained first,
+    then by number; None when none waits. ``trained(cell name)``: the env steps its run has trained,
+    None for a cell not started. A started cell's trial need not be a retry: Optuna's retries of one
+    trial run out after ``roto.sweep.storage.MAX_RETRY`` (3), and a cell reclaimed at the end of
+    every sitting is then enqueued afresh, at the back of the queue.
 
     As ``optuna.Study.ask`` claims one, but in this order: setting a waiting trial running is
     atomic in every storage, so two workers never claim the same trial.
     """
     waiting = study.get_trials(deepcopy=False, states=(TrialState.WAITING,))
 
-    def fresh(trial: optuna.trial.FrozenTrial) -> bool:
-        return RETRY_OF_ATTR not in trial.system_attrs and not started(trial.user_attrs.get(CELL_ATTR, ""))
+    def order(trial: optuna.trial.FrozenTrial) -> tuple[bool, int, int]:
+        steps = trained(trial.user_attrs.get(CELL_ATTR, ""))
+        return RETRY_OF_ATTR not in trial.system_attrs and steps is None, -(steps or 0), trial.number
 
-    for trial in sorted(waiting, key=lambda t: (fresh(t), t.number)):
+    for trial in sorted(waiting, key=order):
         try:
             if storage.set_trial_state_values(trial._trial_id, TrialState.RUNNING):
                 return optuna.Trial(study, trial._trial_id)
         except UpdateFinishedTrialError:  # another worker claimed and finished it meanwhile
             continue
     return None
+
+
+def trained_steps(run_dir: pathlib.Path) -> int | None:
+    """The env steps of the run's last evaluation (0 before the first), None without a checkpoint."""
+    if not checkpoint_path(run_dir).is_file():
+        return None
+    records = read_evaluations(run_dir)
+    return int(records[-1]["env_steps"]) if records else 0
 
 
 def run_olympiad_worker(
@@ -115,7 +129,7 @@ def run_olympiad_worker(
     finished, told = 0, set()
     while True:
         fail_stale_trials(study, storage, grace=4 * heartbeat)
-        trial = claim_next(study, storage, lambda name: name in cells and checkpoint_path(root_dir / name).is_file())
+        trial = claim_next(study, storage, lambda name: trained_steps(root_dir / name) if name in cells else None)
         if trial is None:
             if wait_for_running(study, heartbeat, told):  # a dead worker's cell comes back as a retry
                 continue

@@ -80,26 +80,28 @@ def test_a_killed_workers_cell_is_resumed_from_its_checkpoint(tmp_path):
     assert steps == sorted(set(steps)) and len(steps) > killed_at and steps[-1] == plan.steps  # resumed
 
 
-def test_a_started_cell_is_claimed_before_fresh_cells_without_being_a_retry(tmp_path):
+def test_started_cells_are_claimed_before_fresh_cells_the_most_trained_first_without_being_retries(tmp_path):
     """A cell reclaimed at the end of more sittings than Optuna retries (3) is enqueued afresh, at the
-    back of the queue; its checkpoint still puts it first."""
+    back of the queue; its checkpoint still puts it first, and of two the one nearer its end."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.runner import Trainer
     from tests.rl.toy_env import ToyEnv
 
-    plan = load_plan(str(write_toy_plan(tmp_path, updates=2, seeds=(0,))))
-    root, last = tmp_path / "runs", plan.cells[-1]
-    trainer = Trainer.open(root / plan.name / last.name, cell_spec(plan, last), env_factory=ToyEnv)
-    trainer.train(progress=False)  # a sitting that trained the plan's last cell only, then ended
-    plan_path = write_toy_plan(tmp_path, updates=4, seeds=(0,))  # a longer budget: every cell has work left
+    root = tmp_path / "runs"
+    for updates, index in ((2, -2), (4, -1)):  # sittings that trained only the plan's last two cells
+        plan = load_plan(str(write_toy_plan(tmp_path, updates=updates, seeds=(0,))))
+        Trainer.open(root / plan.name / plan.cells[index].name, cell_spec(plan, plan.cells[index]),
+                     env_factory=ToyEnv).train(progress=False)  # fmt: skip
+    plan_path = write_toy_plan(tmp_path, updates=6, seeds=(0,))  # a longer budget: every cell has work left
 
     assert toy_worker(plan_path, root) == len(plan.cells)
     trials = sorted(load_study(root, plan).trials, key=lambda t: t.datetime_start)
     assert all(t.state == TrialState.COMPLETE and "failed_trial" not in t.system_attrs for t in trials)
-    assert trials[0].user_attrs[CELL_ATTR] == last.name
-    assert trials[0].number == max(t.number for t in trials)  # enqueued last, claimed first
-    steps = [r["env_steps"] for r in read_evaluations(root / plan.name / last.name)]
-    assert steps == sorted(set(steps)) and steps[-1] == 8 * 4 * 4  # continued, not restarted
+    assert [t.user_attrs[CELL_ATTR] for t in trials[:2]] == [plan.cells[-1].name, plan.cells[-2].name]
+    assert [t.number for t in trials[:2]] == [len(plan.cells) - 1, len(plan.cells) - 2]  # enqueued last, claimed first
+    for cell in plan.cells[-2:]:
+        steps = [r["env_steps"] for r in read_evaluations(root / plan.name / cell.name)]
+        assert steps == sorted(set(steps)) and steps[-1] == 8 * 4 * 6  # continued, not restarted
 
 
 def test_a_waiting_cell_no_longer_in_the_plan_is_failed_with_its_name(tmp_path):
