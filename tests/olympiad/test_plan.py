@@ -235,7 +235,7 @@ def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_
     from roto.olympiad.cell import cell_spec
 
     plan, main = load_plan("baoding_v1_shadow_more_aids"), load_plan("baoding_v1_cpu")
-    assert [c.name for c in plan.cells] == ["baoding-shadow-blind-task_critic_more_aids-seed1"]
+    assert [c.name for c in plan.cells] == [f"baoding-shadow-blind-task_critic_more_aids-seed{s}" for s in (0, 1)]
     variant = "task_critic_more_aids"
     assert plan.variants[variant] == main.variants[variant] and (plan.steps, plan.threads) == (main.steps, main.threads)
     three = cell_spec(plan, Cell("baoding", "shadow", "blind", variant, 1))
