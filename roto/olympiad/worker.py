@@ -7,9 +7,9 @@ waiting trials until none is waiting or running. A worker that dies leaves its t
 heartbeat; the next worker to look fails it and enqueues a retry, which continues the cell's run
 from its latest checkpoint and is claimed before any fresh cell, as is any cell whose run has a
 checkpoint, the most trained first (so interrupted cells finish first, and a partial grid is as
-complete as it can be).
-Should a cell be enqueued twice (workers starting at once), the trial with the higher number
-sees the other running or complete and ends as a duplicate: no cell trains twice.
+complete as it can be). Should a cell be enqueued twice (workers starting at once), the trial
+with the higher number sees the other running or complete and ends as a duplicate: no cell
+trains twice.
 """
 
 from __future__ import annotations
