@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from roto.cli_errors import check_output_file, error_exit
 from roto.olympiad.command import add_olympiad_parsers
 from roto.rl.config_help import HelpConfigAction
+from roto.rl.stop_requests import interrupt_on_sigterm
 from roto.sweep.command import add_sweep_parser
 
 
@@ -165,10 +166,9 @@ def _cmd_train(args: argparse.Namespace) -> int:
     print(f"run directory: {trainer.run_dir}", file=sys.stderr)
     try:
         last = trainer.train(progress=not args.no_progress)
-    except KeyboardInterrupt:  # Ctrl-C or a time limit's SIGINT: a stop, not an error
-        print(f"roto train: interrupted at update {trainer.update}; `roto train --resume {trainer.run_dir}` "
-              f"continues from its latest checkpoint (written every {trainer.agent.run.checkpoint_every} updates)",
-              file=sys.stderr)  # fmt: skip
+    except KeyboardInterrupt as stop:  # Ctrl-C, kill or a time limit's signal: a stop, not an error
+        print(f"roto train: interrupted at update {trainer.update} ({str(stop) or 'at once'}); `roto train --resume "
+              f"{trainer.run_dir}` continues from its latest checkpoint", file=sys.stderr)  # fmt: skip
         return 130
     plot_learning_curve(trainer.run_dir)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
@@ -374,6 +374,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``roto`` command."""
     args = build_parser().parse_args(argv)
+    interrupt_on_sigterm()
     try:
         return int(args.func(args))
     except KeyboardInterrupt:  # Ctrl-C: a stop, not an error (a sweep's or Olympiad's trial is retried on the next run)

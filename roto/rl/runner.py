@@ -28,6 +28,7 @@ from roto.rl.run_dir import CHECKPOINT_DIR, RunDir, first_missing, numbered_chec
 from roto.rl.run_lock import hold_run_lock
 from roto.rl.run_spec import RunSpec
 from roto.rl.settings import TrainSettings, read_run_config, run_config, write_run_config
+from roto.rl.stop_requests import StopRequests
 from roto.rl.torch_threads import single_torch_thread
 from roto.rl.wandb_run import logged_wandb_project, open_wandb_run, require_wandb
 
@@ -159,28 +160,31 @@ class Trainer:
         bar = tqdm(total=self.total_updates * self.steps_per_update, initial=self.env_steps, disable=not progress,
                    unit="step", desc=f"{env.task}/{env.robot}/{env.obs_mode}")  # fmt: skip
         try:
-            while self.update < self.total_updates:
-                t_start = time.perf_counter()
-                with single_torch_thread(self.device):
-                    scalars = self._collect_rollout()
-                t_update = time.perf_counter()
-                self.alg.compute_returns(self.obs)
-                scalars.update(self.alg.update())
-                t_end = time.perf_counter()
-                self.update += 1
-                self.env_steps += self.steps_per_update
-                self.train_seconds += t_end - t_start
-                scalars.update({"perf/update_s": t_end - t_update, "perf/train_wall_s": self.train_seconds,
-                                "perf/steps_per_s": self.steps_per_update / (t_end - t_start)})  # fmt: skip
-                scalars.update(self.episodes.read())
-                if self.update % self.agent.run.eval_every == 0 or self.update == self.total_updates:
-                    scalars.update(self._evaluate())
-                logger.log(scalars, self.env_steps, self.update)
-                self._checkpoint()
-                bar.update(self.steps_per_update)
-                bar.set_postfix(self._postfix(scalars))
-                if on_update is not None:
-                    on_update(self, scalars)
+            with StopRequests() as stop:
+                while self.update < self.total_updates:
+                    t_start = time.perf_counter()
+                    with single_torch_thread(self.device):
+                        scalars = self._collect_rollout()
+                    t_update = time.perf_counter()
+                    self.alg.compute_returns(self.obs)
+                    scalars.update(self.alg.update())
+                    t_end = time.perf_counter()
+                    self.update += 1
+                    self.env_steps += self.steps_per_update
+                    self.train_seconds += t_end - t_start
+                    scalars.update({"perf/update_s": t_end - t_update, "perf/train_wall_s": self.train_seconds,
+                                    "perf/steps_per_s": self.steps_per_update / (t_end - t_start)})  # fmt: skip
+                    scalars.update(self.episodes.read())
+                    if self.update % self.agent.run.eval_every == 0 or self.update == self.total_updates:
+                        scalars.update(self._evaluate())
+                    logger.log(scalars, self.env_steps, self.update)
+                    self._checkpoint()
+                    bar.update(self.steps_per_update)
+                    bar.set_postfix(self._postfix(scalars))
+                    if on_update is not None:
+                        on_update(self, scalars)
+                    if stop.requested and self.update < self.total_updates:
+                        self._stop_after_update(stop.signal_name)
         finally:
             bar.close()
             logger.close()
@@ -188,6 +192,12 @@ class Trainer:
                 self._lock.close()
                 self._lock = None
         return dict(self.last_eval)
+
+    def _stop_after_update(self, signal_name: str | None) -> None:
+        """A stop asked for by a signal (``roto.rl.stop_requests``): checkpoint this update, then stop."""
+        if self.update % self.agent.run.checkpoint_every != 0:  # else ``_checkpoint`` has just written it
+            self.save(self.run_dir / CHECKPOINT_DIR / "latest.pt")
+        raise KeyboardInterrupt(f"{signal_name}: stopped after update {self.update}, which latest.pt holds")
 
     def _open_logger(self) -> ScalarLogger:
         """The run's CSV, with TensorBoard and the W&B run as asked."""

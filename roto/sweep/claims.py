@@ -3,7 +3,7 @@
 Shared by ``roto sweep`` (a trial is a set of parameters) and ``roto olympiad`` (a trial is a
 cell of the plan). A ``optuna.TrialPruned`` from the work ends the trial pruned with its message
 as the reason; a trial another worker has meanwhile declared dead (its report refused) is left to
-its retry, which continues the run; any other exception, Ctrl-C included, fails it and enqueues a
+its retry, which continues the run; any other exception, Ctrl-C and SIGTERM included, fails it and enqueues a
 retry, then goes on up. ``launch_workers`` starts worker processes of a ``roto`` subcommand here.
 """
 
@@ -12,6 +12,7 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable, Sequence
 
@@ -79,15 +80,34 @@ def launch_workers(command: str, count: int, argv: Sequence[str]) -> int:
     succeeded, else the first failing worker's exit code (1 for a worker killed by a signal), each
     failure named on stderr.
 
-    Ctrl-C reaches every worker (one process group); each fails and re-enqueues its running trial.
+    Ctrl-C reaches every worker (one process group); a SIGTERM sent to this process alone (``kill``, a
+    scheduler) is passed on to each. Either way each worker finishes its update, checkpoints, fails
+    and re-enqueues its running trial (``roto.rl.stop_requests``), and this waits for them.
     """
     line = [sys.executable, "-m", "roto.cli", command, *argv, "--workers", "1"]
     processes = [subprocess.Popen(line) for _ in range(count)]
+    return worst_exit(wait_passing_on_sigterm(processes), [p.pid for p in processes])
+
+
+def wait_passing_on_sigterm(processes: Sequence[subprocess.Popen]) -> list[int]:
+    """Every process's exit code, once all have ended; a SIGTERM this process gets meanwhile is sent
+    on to those still running (in the main thread; elsewhere SIGTERM keeps its handler)."""
+
+    def pass_on(signum: int, frame: object) -> None:
+        for p in processes:
+            if p.poll() is None:
+                p.send_signal(signum)
+
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, pass_on) if main else None
     try:
-        codes = [p.wait() for p in processes]
-    except KeyboardInterrupt:
-        codes = [p.wait() for p in processes]
-    return worst_exit(codes, [p.pid for p in processes])
+        try:
+            return [p.wait() for p in processes]
+        except KeyboardInterrupt:  # Ctrl-C reached the workers too: wait for their clean stops
+            return [p.wait() for p in processes]
+    finally:
+        if main:
+            signal.signal(signal.SIGTERM, previous)
 
 
 def worst_exit(codes: Sequence[int], pids: Sequence[int]) -> int:

@@ -80,6 +80,35 @@ def test_a_killed_workers_cell_is_resumed_from_its_checkpoint(tmp_path):
     assert steps == sorted(set(steps)) and len(steps) > killed_at and steps[-1] == plan.steps  # resumed
 
 
+def test_a_sigterm_fails_the_workers_cell_at_once_and_its_retry_continues_from_the_stop(tmp_path):
+    """kill (or a scheduler's preemption): the cell's update finishes and is saved, its trial is failed
+    and re-enqueued before the worker exits, so the next worker resumes it without waiting for
+    missed heartbeats."""
+    plan_path = write_toy_plan(tmp_path, updates=60, seeds=(0,))
+    plan, root = load_plan(str(plan_path)), tmp_path / "runs"
+    worker = multiprocessing.get_context("spawn").Process(target=toy_worker, args=(plan_path, root, 60.0))
+    worker.start()
+    first = root / plan.name / plan.cells[0].name
+    deadline = time.time() + 120
+    while len(read_evaluations(first)) < 2:
+        assert time.time() < deadline and worker.is_alive()
+        time.sleep(0.2)
+    os.kill(worker.pid, signal.SIGTERM)
+    worker.join(timeout=60)
+    assert worker.exitcode not in (0, None, -signal.SIGTERM)  # it stopped itself, through its clean-up
+    (stopped,) = load_study(root, plan).trials[:1]
+    assert stopped.state == TrialState.FAIL and "SIGTERM: stopped after update" in stopped.user_attrs[REASON_ATTR]
+    stopped_at = len(read_evaluations(first))
+
+    start = time.time()
+    assert toy_worker(plan_path, root, 60.0) == len(plan.cells)
+    assert time.time() - start < 60  # no stale heartbeat to wait for (they beat every 60 s here)
+    retry = [t for t in load_study(root, plan).trials if t.system_attrs.get("failed_trial") == stopped.number]
+    assert len(retry) == 1 and retry[0].state == TrialState.COMPLETE
+    steps = [r["env_steps"] for r in read_evaluations(first)]
+    assert steps == sorted(set(steps)) and len(steps) > stopped_at and steps[-1] == plan.steps  # resumed
+
+
 def test_started_cells_are_claimed_before_fresh_cells_the_most_trained_first_without_being_retries(tmp_path):
     """A cell reclaimed at the end of more sittings than Optuna retries (3) is enqueued afresh, at the
     back of the queue; its checkpoint still puts it first, and of two the one nearer its end."""

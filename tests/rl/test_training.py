@@ -297,3 +297,30 @@ def test_ppo_projects_the_log_std_after_each_step_only_when_asked(tmp_path):
     projected = tiny_trainer(tmp_path, "projected", 2, [*bound, "network.project_log_std=true"])
     projected.train(progress=False)
     assert torch.equal(projected.model.log_std.detach(), torch.zeros_like(projected.model.log_std))
+
+
+def test_a_signal_stops_training_after_the_update_with_its_checkpoint_and_the_resume_is_exact(tmp_path):
+    """kill or Ctrl-C mid-run (here after update 2 of 4, checkpoints every 50): the run stops once
+    update 2 is done and saved, and continuing it trains as the uninterrupted run."""
+    import os
+    import signal
+
+    from roto.rl.checkpoints import load_checkpoint
+
+    whole = tiny_trainer(tmp_path, "whole", 4)
+    whole.train(progress=False)
+    part = tiny_trainer(tmp_path, "part", 4)
+
+    def kill_at_update_2(trainer, scalars):
+        if trainer.update == 2:
+            os.kill(os.getpid(), signal.SIGTERM)
+
+    with pytest.raises(KeyboardInterrupt, match="SIGTERM: stopped after update 2"):
+        part.train(progress=False, on_update=kill_at_update_2)
+    assert part.agent.run.checkpoint_every > 4
+    assert load_checkpoint(tmp_path / "part" / "checkpoints" / "latest.pt")["update"] == 2
+    resumed = Trainer.resume(tmp_path / "part", tensorboard=False)
+    assert resumed.update == 2
+    resumed.train(progress=False)
+    pw, pr = params(whole), params(resumed)
+    assert all(torch.equal(pw[k], pr[k]) for k in pw)

@@ -100,3 +100,31 @@ def test_a_wrong_database_password_is_one_line_without_the_password(postgres_bin
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "password authentication failed" in err
     assert "wrongpass" not in err and f"roto:***@127.0.0.1:{port}" in err
+
+
+def test_a_sigterm_to_the_launcher_is_passed_on_to_each_running_worker():
+    """``kill`` of ``roto sweep/olympiad --workers N`` reaches the workers, which else would train on
+    orphaned; the launcher waits for them."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import threading
+
+    from roto.sweep.claims import wait_passing_on_sigterm
+
+    sleep = [sys.executable, "-c", "import time; time.sleep(60)"]
+    done = subprocess.Popen([sys.executable, "-c", "pass"])
+    done.wait()
+    workers = [subprocess.Popen(sleep) for _ in range(2)]
+    before = signal.getsignal(signal.SIGTERM)
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGTERM))
+    timer.start()
+    try:
+        codes = wait_passing_on_sigterm([done, *workers])
+    finally:
+        timer.cancel()
+        for worker in workers:
+            worker.kill()
+    assert codes == [0, -signal.SIGTERM, -signal.SIGTERM]
+    assert signal.getsignal(signal.SIGTERM) is before

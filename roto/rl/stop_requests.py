@@ -1,0 +1,65 @@
+"""Stopping a training run between updates, with a checkpoint of the last one.
+
+While a run trains, the first SIGINT (Ctrl-C, ``timeout --signal=INT``) or SIGTERM (``kill``, a
+scheduler's preemption, ``timeout``) only asks it to stop: the update in progress finishes, is
+logged and checkpointed, and the run then stops as if interrupted (``KeyboardInterrupt``), so a
+resume loses nothing. A second signal stops it at once, from wherever it is (a resume then continues
+from the run's previous checkpoint).
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from types import FrameType, TracebackType
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class StopRequests:
+    """A context that turns the first SIGINT or SIGTERM into a request (``requested``, ``signal_name``)
+    and a second into ``KeyboardInterrupt``. Outside the main thread, where Python delivers no
+    signals to handlers, it installs nothing and the signals keep their handlers."""
+
+    def __init__(self) -> None:
+        self.signal_name: str | None = None
+        self._previous: dict[int, object] = {}
+
+    @property
+    def requested(self) -> bool:
+        """Whether a stop was asked for since the context was entered."""
+        return self.signal_name is not None
+
+    def __enter__(self) -> StopRequests:
+        if threading.current_thread() is threading.main_thread():
+            for signum in STOP_SIGNALS:
+                self._previous[signum] = signal.signal(signum, self._handle)
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, traceback: TracebackType | None
+    ) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
+        self._previous.clear()
+
+    def _handle(self, signum: int, frame: FrameType | None) -> None:
+        name = signal.Signals(signum).name
+        if self.requested:
+            raise KeyboardInterrupt(f"{name} after {self.signal_name}: stopped at once")
+        self.signal_name = name
+        print(f"roto: {name}: stopping after this update, with a checkpoint (send it again to stop now)",
+              file=sys.stderr, flush=True)  # fmt: skip
+
+
+def interrupt_on_sigterm() -> None:
+    """From now on SIGTERM stops this process as Ctrl-C does (``KeyboardInterrupt``), so that ``kill``
+    or a scheduler's preemption ends a command through its clean-up (a sweep's or Olympiad's trial
+    is failed and re-enqueued at once) instead of killing it. Main thread only; else nothing."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _raise_interrupt)
+
+
+def _raise_interrupt(signum: int, frame: FrameType | None) -> None:
+    raise KeyboardInterrupt(signal.Signals(signum).name)
