@@ -18,6 +18,19 @@ def load_study(root, plan):
     return optuna.load_study(study_name=study_name(plan), storage=open_storage(root / plan.name))
 
 
+def signal_worker_after_two_evaluations(plan_path, root, heartbeat, first_cell_dir, signum):
+    """Start a toy worker process, send it ``signum`` once its first cell has two evaluations; its exit code."""
+    worker = multiprocessing.get_context("spawn").Process(target=toy_worker, args=(plan_path, root, heartbeat))
+    worker.start()
+    deadline = time.time() + 120
+    while len(read_evaluations(first_cell_dir)) < 2:
+        assert time.time() < deadline and worker.is_alive()
+        time.sleep(0.2)
+    os.kill(worker.pid, signum)
+    worker.join(timeout=60)
+    return worker.exitcode
+
+
 def test_two_workers_finish_every_cell_once(tmp_path):
     plan_path = write_toy_plan(tmp_path)
     plan, root = load_plan(str(plan_path)), tmp_path / "runs"
@@ -54,15 +67,8 @@ def test_two_workers_finish_every_cell_once(tmp_path):
 def test_a_killed_workers_cell_is_resumed_from_its_checkpoint(tmp_path):
     plan_path = write_toy_plan(tmp_path, updates=60, seeds=(0,))
     plan, root = load_plan(str(plan_path)), tmp_path / "runs"
-    worker = multiprocessing.get_context("spawn").Process(target=toy_worker, args=(plan_path, root, 0.5))
-    worker.start()
     first = root / plan.name / plan.cells[0].name
-    deadline = time.time() + 120
-    while len(read_evaluations(first)) < 2:
-        assert time.time() < deadline and worker.is_alive()
-        time.sleep(0.2)
-    os.kill(worker.pid, signal.SIGKILL)
-    worker.join()
+    signal_worker_after_two_evaluations(plan_path, root, 0.5, first, signal.SIGKILL)
     killed_at = len(read_evaluations(first))
     time.sleep(2.5)  # four missed heartbeats
 
@@ -86,16 +92,9 @@ def test_a_sigterm_fails_the_workers_cell_at_once_and_its_retry_continues_from_t
     missed heartbeats."""
     plan_path = write_toy_plan(tmp_path, updates=60, seeds=(0,))
     plan, root = load_plan(str(plan_path)), tmp_path / "runs"
-    worker = multiprocessing.get_context("spawn").Process(target=toy_worker, args=(plan_path, root, 60.0))
-    worker.start()
     first = root / plan.name / plan.cells[0].name
-    deadline = time.time() + 120
-    while len(read_evaluations(first)) < 2:
-        assert time.time() < deadline and worker.is_alive()
-        time.sleep(0.2)
-    os.kill(worker.pid, signal.SIGTERM)
-    worker.join(timeout=60)
-    assert worker.exitcode not in (0, None, -signal.SIGTERM)  # it stopped itself, through its clean-up
+    exitcode = signal_worker_after_two_evaluations(plan_path, root, 60.0, first, signal.SIGTERM)
+    assert exitcode not in (0, None, -signal.SIGTERM)  # it stopped itself, through its clean-up
     (stopped,) = load_study(root, plan).trials[:1]
     assert stopped.state == TrialState.FAIL and "SIGTERM: stopped after update" in stopped.user_attrs[REASON_ATTR]
     stopped_at = len(read_evaluations(first))
