@@ -248,6 +248,32 @@ def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_
     }
 
 
+def test_each_ablation_changes_exactly_its_part_of_the_baoding_recipe():
+    """The ablations' recipe is the Olympiad's Baoding recipe; every other cell differs from it in one part only."""
+    from roto.olympiad.cell import cell_spec
+
+    plan, main = load_plan("baoding_v1_ablations"), load_plan("baoding_v1_cpu")
+    assert {c.seed for c in plan.cells} == {1} and {c.robot for c in plan.cells} == {"shadow"}
+    recipe = cell_spec(plan, Cell("baoding", "shadow", "blind", "recipe", 1))
+    assert recipe.differences(cell_spec(main, Cell("baoding", "shadow", "blind", "task_critic_more_aids", 1))) == {}
+    bank = "benchmarks/results/baoding_reference/shadow_preswap.npz"
+    expected = {
+        "recipe": {},
+        "no_replay": {"env.replay_starts": (None, bank), "env.replay_share": (0.0, 0.5),
+                      "env.replay_record_lead": (0, 10)},
+        "no_own_swaps": {"env.replay_record_lead": (0, 10)},
+        "no_tolerance": {"env.tolerance_start": (0.0, 0.025), "env.tolerance_target": (1.0, 2)},
+        "plain_critic": {"agent.network.critic": (None, ["tactile", "proprio", "privileged", "task"])},
+        "roto_epochs": {"agent.ppo.epochs": (8, 4)},
+        "std_bound": {"agent.network.max_log_std": (0.0, 2.0)},
+        "std_bound_projected": {"agent.network.max_log_std": (0.0, 2.0),
+                                "agent.network.project_log_std": (True, False)},
+    }  # fmt: skip
+    assert [c.variant for c in plan.cells] == list(expected)
+    for variant, changes in expected.items():
+        assert cell_spec(plan, Cell("baoding", "shadow", "blind", variant, 1)).differences(recipe) == changes, variant
+
+
 def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_starts():
     from roto.olympiad.cell import cell_spec
 
