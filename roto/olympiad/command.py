@@ -88,6 +88,16 @@ def recent_rate(records: list[dict]) -> float | None:
     return (records[-1]["env_steps"] - records[-2]["env_steps"]) / seconds if seconds > 0 else None
 
 
+def headline_so_far(records: list[dict], metric: str) -> str:
+    """``; last evaluation X <metric>, best Y at Z M`` from a run's evaluation records ("" without the metric)."""
+    scored = [r for r in records if f"{metric}_mean" in r]
+    if not scored:
+        return ""
+    best = max(scored, key=lambda r: r[f"{metric}_mean"])
+    return (f"; last evaluation {scored[-1][f'{metric}_mean']:.2f} {metric}, "
+            f"best {best[f'{metric}_mean']:.2f} at {best['env_steps'] / 1e6:.1f} M")  # fmt: skip
+
+
 def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1) -> str:
     """The cells and their status, and the time left at the throughput of the finished cells for
     the env steps left (a started cell counts the env steps of its run's last evaluation); with
@@ -96,8 +106,10 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
     from roto.olympiad.results import read_summaries
     from roto.olympiad.worker import cell_status
     from roto.rl.evaluation import read_evaluations
+    from roto.tasks import get_task
 
     status = cell_status(plan, root, results, storage)
+    metrics = {cell.name: get_task(cell.task).headline_metric for cell in plan.cells}
     lines = [f"plan {plan.name}: {len(plan.cells)} cells, {plan.steps} env steps each", ""]
     done_steps, running_rates = {}, []
     for name, state in status.items():
@@ -106,7 +118,8 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
         rate_now = recent_rate(records) if state == "running" else None
         if rate_now:
             running_rates.append(rate_now)
-        progress = f" ({done_steps[name] / 1e6:.1f} M env steps)" if done_steps[name] else ""
+        so_far = headline_so_far(records, metrics[name])
+        progress = f" ({done_steps[name] / 1e6:.1f} M env steps{so_far})" if records else ""
         lines.append(f"  {name:<52} {state}{progress}")
     left = sum(state != "done" for state in status.values())
     cells_left = [plan.steps - done_steps[name] for name, state in status.items() if state != "done"]

@@ -88,10 +88,13 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     assert not (tmp_path / "cpu").exists()  # a dry run creates no study
     started = tmp_path / "cpu" / "bounce-allegro-blind-ppo-seed0"  # a cell's run, 2.5 M steps in
     started.mkdir(parents=True)
-    (started / "evaluations.jsonl").write_text(json.dumps({"update": 610, "env_steps": 2_500_000}) + "\n")
+    rounds = [{"update": 305, "env_steps": 1_250_000, "bounces_mean": 31.5},
+              {"update": 610, "env_steps": 2_500_000, "bounces_mean": 27.25}]  # fmt: skip
+    (started / "evaluations.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rounds))
     assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
     out = capsys.readouterr().out
-    assert "bounce-allegro-blind-ppo-seed0" in out and "(2.5 M env steps)" in out
+    assert "bounce-allegro-blind-ppo-seed0" in out
+    assert "(2.5 M env steps; last evaluation 27.25 bounces, best 31.50 at 1.2 M)" in out
     assert "time left: 4.0 h for one worker" in out  # (75 M - 2.5 M) / 5000 env steps/s = 14500 s
     assert main(["olympiad", "cpu", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
                  str(results)]) == 0  # fmt: skip
