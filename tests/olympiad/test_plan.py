@@ -271,6 +271,7 @@ def test_each_ablation_changes_exactly_its_part_of_the_baoding_recipe():
         "std_bound": {"agent.network.max_log_std": (0.0, 2.0)},
         "std_bound_projected": {"agent.network.max_log_std": (0.0, 2.0),
                                 "agent.network.project_log_std": (True, False)},
+        "low_noise": {"agent.network.init_log_std": (-1.386, 0.0), "agent.network.max_log_std": (-1.386, 2.0)},
     }  # fmt: skip
     assert [c.variant for c in plan.cells] == list(expected)
     for variant, changes in expected.items():
