@@ -106,8 +106,8 @@ def wait_passing_on_sigterm(processes: Sequence[subprocess.Popen]) -> list[int]:
         except KeyboardInterrupt:  # Ctrl-C reached the workers too: wait for their clean stops
             return [p.wait() for p in processes]
     finally:
-        if main:
-            signal.signal(signal.SIGTERM, previous)
+        if main:  # None: a handler not set from Python
+            signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 def worst_exit(codes: Sequence[int], pids: Sequence[int]) -> int:
