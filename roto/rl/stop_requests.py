@@ -9,22 +9,38 @@ from the run's previous checkpoint).
 
 from __future__ import annotations
 
+import contextlib
 import signal
 import sys
 import threading
+from collections.abc import Callable, Iterator
 from types import FrameType, TracebackType
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
+@contextlib.contextmanager
+def signal_handlers(handlers: dict[int, Callable[[int, FrameType | None], None]]) -> Iterator[None]:
+    """``handlers`` ({signal: handler}) for the block, the previous handlers back after it. Outside
+    the main thread, where Python delivers no signals to handlers, it installs nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {signum: signal.signal(signum, handler) for signum, handler in handlers.items()}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():  # None: a handler not set from Python
+            signal.signal(signum, signal.SIG_DFL if handler is None else handler)
+
+
 class StopRequests:
     """A context that turns the first SIGINT or SIGTERM into a request (``requested``, ``signal_name``)
-    and a second into ``KeyboardInterrupt``. Outside the main thread, where Python delivers no
-    signals to handlers, it installs nothing and the signals keep their handlers."""
+    and a second into ``KeyboardInterrupt`` (``signal_handlers``: main thread only)."""
 
     def __init__(self) -> None:
         self.signal_name: str | None = None
-        self._previous: dict[int, object] = {}
+        self._handlers = signal_handlers(dict.fromkeys(STOP_SIGNALS, self._handle))
 
     @property
     def requested(self) -> bool:
@@ -32,17 +48,13 @@ class StopRequests:
         return self.signal_name is not None
 
     def __enter__(self) -> StopRequests:
-        if threading.current_thread() is threading.main_thread():
-            for signum in STOP_SIGNALS:
-                self._previous[signum] = signal.signal(signum, self._handle)
+        self._handlers.__enter__()
         return self
 
     def __exit__(
         self, kind: type[BaseException] | None, error: BaseException | None, traceback: TracebackType | None
     ) -> None:
-        for signum, handler in self._previous.items():  # None: a handler not set from Python
-            signal.signal(signum, signal.SIG_DFL if handler is None else handler)
-        self._previous.clear()
+        self._handlers.__exit__(kind, error, traceback)
 
     def _handle(self, signum: int, frame: FrameType | None) -> None:
         name = signal.Signals(signum).name

@@ -12,7 +12,6 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
-import threading
 import time
 from collections.abc import Callable, Sequence
 
@@ -20,6 +19,7 @@ import optuna
 from optuna.exceptions import UpdateFinishedTrialError
 from optuna.trial import TrialState
 
+from roto.rl.stop_requests import signal_handlers
 from roto.sweep.storage import REASON_ATTR, Heartbeat, enqueue_retry
 
 
@@ -98,16 +98,11 @@ def wait_passing_on_sigterm(processes: Sequence[subprocess.Popen]) -> list[int]:
             if p.poll() is None:
                 p.send_signal(signum)
 
-    main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, pass_on) if main else None
-    try:
+    with signal_handlers({signal.SIGTERM: pass_on}):
         try:
             return [p.wait() for p in processes]
         except KeyboardInterrupt:  # Ctrl-C reached the workers too: wait for their clean stops
             return [p.wait() for p in processes]
-    finally:
-        if main:  # None: a handler not set from Python
-            signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 def worst_exit(codes: Sequence[int], pids: Sequence[int]) -> int:
