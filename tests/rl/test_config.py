@@ -162,13 +162,13 @@ def test_roto_bounce_numbers_live_in_the_config_classes_and_baoding_is_a_diff():
 
 
 def test_bounce_gpu_is_the_agent_of_the_recorded_gpu_run():
-    """roto/configs/bounce_gpu.yaml must train exactly as the H200 run its comment reports."""
+    """roto/configs/bounce_gpu.yaml must train exactly as the H100 run its comment reports."""
     import pathlib
 
     import yaml
 
     run_config = pathlib.Path(__file__).parents[2] / (
-        "benchmarks/results/gpu_h200_2026-11-26/train_bounce_shadow_8192_quickstart_seed0/config.yaml"
+        "benchmarks/results/gpu_h100_2026-11-26/train_bounce_shadow_8192_gpu_tf32_seed1/config.yaml"
     )
     recorded = yaml.safe_load(run_config.read_text())["agent"]  # keys added since then take their defaults
     assert load_agent_config("bounce", "bounce_gpu") == from_dict(AgentConfig, recorded)
