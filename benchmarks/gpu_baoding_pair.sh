@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Blind Shadow Baoding at 8192 envs on one GPU sitting: the CPU recipe (baoding_cpu_shadow: a critic
-# that reads the task's state, 4 epochs, a quarter of the training starts replayed from the Shadow
-# reference controller's bank) against roto's own recipe (baoding), both with the CUDA-graph update,
+# that reads the task's state, 4 epochs, and three training-only aids: half the training starts replayed
+# from the Shadow's bank of pre-swap states, its own swaps recorded into it, a latch radius narrowing
+# from 2.5 to 1 cm) against roto's own recipe (baoding), both with the CUDA-graph update,
 # seed 0, each for half the time left after the Baoding kernels are compiled (by a `roto bench` of
 # baoding:shadow, which also gives the simulation-only speed to compare with).
 #   usage (on the GPU machine, in the repo root, after `bash benchmarks/gpu_machine.sh install ...`

@@ -215,7 +215,7 @@ def test_the_low_noise_variant_differs_from_all_three_only_in_the_policy_std():
 @pytest.mark.parametrize(
     ("robot", "variant"),
     [
-        ("shadow", "task_critic_replay"),
+        ("shadow", "task_critic_more_aids"),
         ("shadow_lite", "task_critic_more_aids"),
         ("allegro", "task_critic_more_aids"),
         ("orca", "task_critic_more_aids_low_noise"),
