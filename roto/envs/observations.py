@@ -123,6 +123,19 @@ def privileged_frame(ball_pos: torch.Tensor, ball_vel: torch.Tensor) -> torch.Te
     return torch.cat([ball_pos, ball_vel], dim=-1).flatten(1).to(torch.float32)
 
 
+def ball_positions(privileged: torch.Tensor, n_ball: int) -> torch.Tensor:
+    """The balls' centres in the newest frame of a stacked ``privileged`` group (``privileged_frame``'s layout).
+
+    Args:
+        privileged: (B, k·6·n_ball), k frames oldest to newest.
+
+    Returns:
+        (B, n_ball, 3) positions (task frame, m).
+    """
+    newest = privileged[:, -6 * n_ball :]
+    return newest.unflatten(1, (n_ball, 6))[..., :3]
+
+
 def task_frame(task_observation: torch.Tensor, length: torch.Tensor, episode_steps: int) -> torch.Tensor:
     """The ``task`` group: the task's state features (``Task.observation``), then the share of the
     episode left.

@@ -11,9 +11,11 @@ import torch
 from roto.envs.config import EnvConfig
 from roto.envs.episodes import first_episodes
 from roto.envs.roto_env import RotoEnv
+from roto.eval.ball_paths import BallPathRecorder, with_ball_state
 from roto.rl.networks import ActorCritic
 from roto.rl.settings import TrainSettings
 from roto.rl.torch_threads import single_torch_thread
+from roto.tasks import get_task
 
 MAX_PARALLEL_ENVS = 128
 
@@ -28,20 +30,26 @@ def evaluate(
 ) -> dict[str, object]:
     """Run ``episodes`` full episodes, one per env (so short episodes are not favoured), on the CPU.
 
-    Returns mean and std of the return, length and every task metric, and the per-episode lists.
+    Returns mean and std of the return, length, every task metric and path metric
+    (``Task.path_metrics``), and the per-episode lists.
     """
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
+    measures_path = bool(get_task(settings.env.task).path_metric_names)
     per_episode: dict[str, list[float]] = {}
     for batch in range(math.ceil(episodes / MAX_PARALLEL_ENVS)):
         n = min(MAX_PARALLEL_ENVS, episodes - batch * MAX_PARALLEL_ENVS)
-        env = env_factory(settings.cpu_env_config(num_envs=n, seed=seed + batch))
+        config = settings.cpu_env_config(num_envs=n, seed=seed + batch)
+        env = env_factory(with_ball_state(config) if measures_path else config)
+        task = env.task  # the env's own: a test double's measures no path
+        act = BallPathRecorder(model.act_deterministic, len(env.balls)) if task.path_metric_names else None
         obs, _ = env.reset(seed=seed + batch)
         with single_torch_thread(env.device):
-            result = first_episodes(env, model.act_deterministic, obs)
+            result = first_episodes(env, act or model.act_deterministic, obs)
         env.close()
-        for name, values in result.items():
-            per_episode.setdefault(name, []).extend(values[:, 0].tolist())
+        paths = act.path_metrics(task, result["length"][:, 0]) if act is not None else {}
+        for name, values in [*((k, v[:, 0].tolist()) for k, v in result.items()), *paths.items()]:
+            per_episode.setdefault(name, []).extend(values)
     summary: dict[str, object] = {"episodes": episodes}
     for key, values in per_episode.items():
         t = torch.tensor(values, dtype=torch.float64)

@@ -13,6 +13,7 @@ from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
 from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where
 from roto.tasks.base import PALM_DROP_LIMIT, Marker, StepResult, TaskInputs, clear_where, uniform
+from roto.tasks.pair_turns import pair_turns
 
 BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
@@ -144,6 +145,9 @@ class Baoding:
     """Rotations per 10 s of the predictive-sampling reference controller, 16 episodes each,
     ``roto demo --task baoding`` (docs/robots.md)."""
     observation_size = 8
+    path_metric_names = ("net_turns", "travelled_turns")
+    """Whether the balls went round each other or swung out and back (``roto.tasks.pair_turns``): a
+    swap counts either way."""
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """Two 55 g balls of the robot's Baoding diameter."""
@@ -206,3 +210,8 @@ class Baoding:
         return [
             Marker(pos=current[:, i], radius=SUCCESS_RADIUS, rgba=(*rgb, 0.35)) for i, rgb in enumerate(BALL_COLOURS)
         ]
+
+    def path_metrics(self, ball_path: torch.Tensor) -> dict[str, float]:
+        """Net and travelled turns of the line between the balls over the episode (``pair_turns``)."""
+        net, travelled = pair_turns(ball_path)
+        return {"net_turns": net, "travelled_turns": travelled}

@@ -82,6 +82,9 @@ class Task(Protocol):
     is set beside."""
     observation_size: int
     """Features per world of ``observation`` (the ``task`` observation group holds one more: time left)."""
+    path_metric_names: tuple[str, ...]
+    """Episode measures read from the balls' whole path (``path_metrics``), beside ``metric_names``;
+    evaluation reports them, training never sees them. May be empty."""
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """The free objects this task puts in the scene for ``robot``."""
@@ -114,6 +117,10 @@ class Task(Protocol):
 
     def markers(self, state: object) -> list[Marker]:
         """What pictures and videos should draw besides the scene (e.g. targets); may be empty."""
+        ...
+
+    def path_metrics(self, ball_path: torch.Tensor) -> dict[str, float]:
+        """``path_metric_names`` of one episode from its balls' centres ``ball_path`` (T, n_ball, 3)."""
         ...
 
 

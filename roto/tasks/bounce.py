@@ -71,6 +71,7 @@ class Bounce:
     reference = MappingProxyType({"shadow": 27.9, "shadow_lite": 9.5, "allegro": 11.8, "orca": 12.0})
     """Bounces per 10 s of each hand's scripted policy, ``roto demo`` (docs/robots.md)."""
     observation_size = 3
+    path_metric_names = ()
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """One 70 mm, 30 g ball for every hand."""
@@ -118,3 +119,7 @@ class Bounce:
     def markers(self, state: BounceState) -> list[Marker]:
         """None: Bounce has no targets."""
         return []
+
+    def path_metrics(self, ball_path: torch.Tensor) -> dict[str, float]:
+        """None: a bounce count says all the path does."""
+        return {}

@@ -20,6 +20,7 @@ EPISODE_STEPS = 8
 class _ToyTask:
     metric_names: tuple[str, ...] = ("hits",)
     headline_metric: str = "hits"
+    path_metric_names: tuple[str, ...] = ()
 
 
 class ToyEnv:

@@ -3,7 +3,7 @@ import math
 import pytest
 import torch
 
-from roto.eval.pair_turns import pair_turns
+from roto.tasks.pair_turns import pair_turns
 
 
 def balls_around(centre: torch.Tensor, angle: torch.Tensor, u: torch.Tensor, v: torch.Tensor, r: float) -> torch.Tensor:
@@ -44,3 +44,12 @@ def test_a_held_pair_turns_not_at_all_and_bad_shapes_are_refused():
     assert pair_turns(still) == (0.0, 0.0) and pair_turns(still[:1]) == (0.0, 0.0)
     with pytest.raises(ValueError, match=r"shape \(T, 2, 3\), got \(50, 6\)"):
         pair_turns(still.reshape(50, 6))
+
+
+def test_baodings_path_metrics_are_the_pairs_net_and_travelled_turns():
+    from roto.tasks.baoding import Baoding
+
+    angle = torch.linspace(0, 2 * math.pi, 201, dtype=torch.float64)
+    path = balls_around(CENTRE, angle, TILTED_U, TILTED_V, 0.02)
+    task = Baoding()
+    assert task.path_metrics(path) == dict(zip(task.path_metric_names, pair_turns(path), strict=True))
