@@ -144,6 +144,28 @@ def _format(stats: dict | None) -> str:
     return f"{stats['mean']:.1f} ± {stats['std']:.1f} (IQM {stats['iqm']:.1f} {interval}, n={stats['n']})"
 
 
+def path_metric_table(summaries: list[dict]) -> list[str]:
+    """Markdown lines: each seed's ``best.pt`` headline metric beside its path metrics
+    (``Task.path_metrics``, e.g. Baoding's net turns), a table per task that has them; empty if none
+    does. Summaries written before evaluations measured paths say "not measured"."""
+    lines = []
+    for task in sorted({s["task"] for s in summaries}):
+        names = get_task(task).path_metric_names
+        if not names:
+            continue
+        header = ["cell", f"{metric(task)} (best.pt)", *names]
+        lines += [f"## best policy, {task}: path metrics beside the headline metric, per seed", "",
+                  "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]  # fmt: skip
+        for s in sorted(summaries, key=lambda s: (s["robot"], s["obs"], s["variant"], s["seed"])):
+            if s["task"] == task:
+                best = s["best"]
+                values = [f"{best[f'{n}_mean']:.2f}" if f"{n}_mean" in best else "not measured" for n in names]
+                cell = f"{s['robot']} / {s['obs']} / {s['variant']} / seed {s['seed']}"
+                lines.append("| " + " | ".join([cell, f"{best[f'{metric(task)}_mean']:.2f}", *values]) + " |")
+        lines.append("")
+    return lines
+
+
 def write_csv(scores: dict[Key, np.ndarray], path: pathlib.Path, policy: str) -> None:
     """One row per cell: its statistics and its seeds' scores."""
     with replacing(path) as temporary, temporary.open("w", newline="") as f:
@@ -208,6 +230,7 @@ def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str
         write_csv(scores, out / f"results_{policy}.csv", policy)
         heading = f"## {policy} policy: task metric per 10 s episode, mean ± std over seeds"
         md += [heading, "", markdown_table(scores, agents, current_tasks(summaries)), ""]
+    md += path_metric_table(summaries)
     pairs = improvements(scores_by_cell(summaries, "final"))
     if pairs:
         md += ["## Probability of improvement (final policies)", ""]

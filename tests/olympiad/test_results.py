@@ -88,3 +88,19 @@ def test_no_roto_v1_row_where_no_column_is_roto_agent():
     assert "roto v1" not in plain and "| shadow | 10.0 ± 0.0" in plain
     roto = markdown_table(scores, {("baoding", "recipe"): {"label": "roto's", "roto_agent": "ppo"}}, {"baoding"})
     assert "| roto v1, Shadow, 200 M steps (5 seeds) | 5.1 (ppo) |  |" in roto
+
+
+def test_path_metrics_stand_beside_the_headline_metric_and_older_summaries_say_not_measured(tmp_path):
+    from roto.olympiad.results import write_results
+
+    write_summaries(tmp_path / "summaries")
+    newer = json.loads((tmp_path / "summaries" / "baoding-allegro-blind-ppo-seed0.json").read_text())
+    newer["seed"] = 1
+    newer["best"].update({"net_turns_mean": 0.25, "travelled_turns_mean": 14.62})
+    (tmp_path / "summaries" / "baoding-allegro-blind-ppo-seed1.json").write_text(json.dumps(newer))
+    write_results(tmp_path / "summaries", tmp_path / "out")
+    md = (tmp_path / "out" / "results.md").read_text()
+    assert "| cell | rotations (best.pt) | net_turns | travelled_turns |" in md
+    assert "| allegro / blind / ppo / seed 0 | 2.00 | not measured | not measured |" in md
+    assert "| allegro / blind / ppo / seed 1 | 2.00 | 0.25 | 14.62 |" in md
+    assert md.count("path metrics") == 1  # a table for Baoding, none for Bounce
