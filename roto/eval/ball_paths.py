@@ -9,11 +9,14 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from typing import Any
 
 import torch
 
 from roto.envs.config import EnvConfig
+from roto.envs.episodes import first_episodes
 from roto.envs.observations import OBS_MODES, ball_positions
+from roto.tasks import get_task
 from roto.tasks.base import Task
 
 BALL_GROUP = "privileged"
@@ -26,6 +29,11 @@ def with_ball_state(config: EnvConfig) -> EnvConfig:
     return dataclasses.replace(config, extra_groups=(*config.extra_groups, BALL_GROUP))
 
 
+def for_path_metrics(config: EnvConfig) -> EnvConfig:
+    """An evaluation env config: with the balls' state where its task has path metrics."""
+    return with_ball_state(config) if get_task(config.task).path_metric_names else config
+
+
 class BallPathRecorder:
     """An act function that keeps the balls' centres of every observation before acting on it.
 
@@ -36,10 +44,10 @@ class BallPathRecorder:
 
     def __init__(self, act: Callable[[dict[str, torch.Tensor]], torch.Tensor], n_ball: int) -> None:
         self.act, self.n_ball = act, n_ball
-        self.positions: list[torch.Tensor] = []
+        self.positions: list[torch.Tensor] = []  # on the envs' device until the episodes end
 
     def __call__(self, obs: dict[str, torch.Tensor]) -> torch.Tensor:
-        self.positions.append(ball_positions(obs[BALL_GROUP], self.n_ball).cpu())
+        self.positions.append(ball_positions(obs[BALL_GROUP], self.n_ball).clone())
         return self.act(obs)
 
     def path_metrics(self, task: Task, lengths: torch.Tensor) -> dict[str, list[float]]:
@@ -51,6 +59,21 @@ class BallPathRecorder:
         Returns:
             {name: B values}, in env order.
         """
-        path = torch.stack(self.positions)  # (steps, B, n_ball, 3)
+        path = torch.stack(self.positions).cpu()  # (steps, B, n_ball, 3)
         rows = [task.path_metrics(path[: int(length), i]) for i, length in enumerate(lengths.tolist())]
         return {name: [row[name] for row in rows] for name in task.path_metric_names}
+
+
+def first_episodes_with_paths(
+    env: Any, act: Callable[[dict[str, torch.Tensor]], torch.Tensor], obs: dict[str, torch.Tensor]
+) -> dict[str, list[float]]:
+    """The first episode of each env (``first_episodes``) as lists of the return, length and task
+    metrics, and of the env's task's path metrics where it has any (its envs must then return
+    the ``privileged`` group: ``for_path_metrics``)."""
+    names = env.task.path_metric_names
+    recorder = BallPathRecorder(act, len(env.balls)) if names else None
+    result = first_episodes(env, recorder or act, obs)
+    per_episode = {name: values[:, 0].tolist() for name, values in result.items()}
+    if recorder is not None:
+        per_episode.update(recorder.path_metrics(env.task, result["length"][:, 0]))
+    return per_episode

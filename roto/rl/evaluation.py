@@ -15,7 +15,7 @@ from typing import Any
 
 import torch
 
-from roto.envs.episodes import first_episodes
+from roto.eval.ball_paths import first_episodes_with_paths
 from roto.result_files import write_text_atomic
 from roto.rl.networks import ActorCritic
 from roto.rl.torch_threads import single_torch_thread
@@ -51,16 +51,15 @@ class PolicyEvaluator:
         """Run one episode per env with ``model``'s mean action; append and return the record.
 
         ``fields`` (update, env steps, training wall time ...) lead the record; then the mean and
-        std of the return, length and each task metric, and the per-episode lists.
+        std of the return, length, each task metric and path metric, and the per-episode lists.
         """
         start = time.perf_counter()
         obs, _ = self.env.reset(seed=self.seed)
         was_training = model.training
         model.eval()
         with single_torch_thread(self.env.device):
-            result = first_episodes(self.env, model.act_deterministic, obs)
+            per_episode = first_episodes_with_paths(self.env, model.act_deterministic, obs)
         model.train(was_training)
-        per_episode = {name: values[:, 0].tolist() for name, values in result.items()}
         record = {**fields, "eval_s": time.perf_counter() - start, **summarize(per_episode)}
         record["per_episode"] = per_episode
         with self.path.open("a") as f:

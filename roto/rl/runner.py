@@ -19,6 +19,7 @@ from tqdm import tqdm
 from roto.envs.config import EnvConfig
 from roto.envs.episodes import readable
 from roto.envs.roto_env import RotoEnv
+from roto.eval.ball_paths import for_path_metrics
 from roto.rl.build import build_learner, build_model, extra_groups, stacked_sizes
 from roto.rl.checkpoints import load_checkpoint, save_checkpoint
 from roto.rl.config import AgentConfig, to_dict
@@ -115,7 +116,7 @@ class Trainer:
         num_eval = agent.run.num_eval_envs_gpu if self.device.type == "cuda" else agent.run.num_eval_envs
         eval_seed = settings.env.seed + EVAL_SEED_OFFSET
         self.evaluator = PolicyEvaluator(
-            env_factory(settings.eval_env_config(num_eval, eval_seed)), eval_seed, self.run_dir
+            env_factory(for_path_metrics(settings.eval_env_config(num_eval, eval_seed))), eval_seed, self.run_dir
         )
         torch.manual_seed(settings.env.seed)
         sizes = stacked_sizes(self.env)

@@ -53,3 +53,16 @@ def test_a_bounce_evaluation_has_no_path_metrics():
     settings = TrainSettings(env=EnvConfig(task="bounce", robot="shadow", num_envs=1))
     summary = evaluate(untrained_blind_policy(), settings, episodes=1)
     assert set(summary["per_episode"]) == {"return", "length", "bounces"}
+
+
+def test_training_time_evaluations_of_baoding_record_the_pair_turns(tmp_path):
+    from roto.rl.config import load_agent_config
+    from roto.rl.runner import Trainer
+
+    env = EnvConfig(task="baoding", robot="shadow", num_envs=2, seed=3)
+    agent = load_agent_config("baoding", overrides=["run.num_eval_envs=2", "ppo.rollouts=4", "ppo.minibatches=1"])
+    trainer = Trainer(TrainSettings(env=env, total_steps=8), agent, tmp_path / "run", tensorboard=False)
+    assert "privileged" in trainer.evaluator.env.config.extra_groups  # the blind policy still reads none of it
+    record = trainer.evaluator.evaluate(trainer.model, update=0)
+    assert len(record["per_episode"]["net_turns"]) == 2
+    assert 0.0 <= record["net_turns_mean"] <= record["travelled_turns_mean"]
