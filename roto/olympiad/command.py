@@ -88,13 +88,15 @@ def recent_rate(records: list[dict]) -> float | None:
     return (records[-1]["env_steps"] - records[-2]["env_steps"]) / seconds if seconds > 0 else None
 
 
-def headline_so_far(records: list[dict], metric: str) -> str:
-    """``; last evaluation X <metric>, best Y at Z M`` from a run's evaluation records ("" without the metric)."""
+def headline_so_far(records: list[dict], metric: str, path_metrics: tuple[str, ...] = ()) -> str:
+    """``; last evaluation X <metric> (<path metric> P, ...), best Y at Z M`` from a run's evaluation
+    records ("" without the metric; each path metric only where the last record has it)."""
     scored = [r for r in records if f"{metric}_mean" in r]
     if not scored:
         return ""
-    best = max(scored, key=lambda r: r[f"{metric}_mean"])
-    return (f"; last evaluation {scored[-1][f'{metric}_mean']:.2f} {metric}, "
+    last, best = scored[-1], max(scored, key=lambda r: r[f"{metric}_mean"])
+    paths = ", ".join(f"{name} {last[f'{name}_mean']:.2f}" for name in path_metrics if f"{name}_mean" in last)
+    return (f"; last evaluation {last[f'{metric}_mean']:.2f} {metric}{f' ({paths})' if paths else ''}, "
             f"best {best[f'{metric}_mean']:.2f} at {best['env_steps'] / 1e6:.1f} M")  # fmt: skip
 
 
@@ -109,7 +111,7 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
     from roto.tasks import get_task
 
     status = cell_status(plan, root, results, storage)
-    metrics = {cell.name: get_task(cell.task).headline_metric for cell in plan.cells}
+    tasks = {cell.name: get_task(cell.task) for cell in plan.cells}
     lines = [f"plan {plan.name}: {len(plan.cells)} cells, {plan.steps} env steps each", ""]
     done_steps, running_rates = {}, []
     for name, state in status.items():
@@ -118,7 +120,7 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
         rate_now = recent_rate(records) if state == "running" else None
         if rate_now:
             running_rates.append(rate_now)
-        so_far = headline_so_far(records, metrics[name])
+        so_far = headline_so_far(records, tasks[name].headline_metric, tasks[name].path_metric_names)
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps{so_far})" if records else ""
         lines.append(f"  {name:<52} {state}{progress}")
     left = sum(state != "done" for state in status.values())

@@ -298,3 +298,14 @@ def test_the_busiest_worker_and_a_running_cells_rate():
     records = [{"env_steps": 1000, "train_wall_s": 10.0}, {"env_steps": 4000, "train_wall_s": 12.0}]
     assert recent_rate(records) == 1500.0
     assert recent_rate(records[:1]) is None and recent_rate([{"env_steps": 1}, {"env_steps": 2}]) is None
+
+
+def test_the_dry_run_line_shows_the_last_evaluations_path_metrics_where_it_has_them():
+    from roto.olympiad.command import headline_so_far
+
+    turns = {"net_turns_mean": 0.25, "travelled_turns_mean": 3.5}
+    rounds = [{"env_steps": 1_000_000, "rotations_mean": 6.0}, {"env_steps": 2_000_000, "rotations_mean": 5.5, **turns}]
+    names = ("net_turns", "travelled_turns")
+    line = headline_so_far(rounds, "rotations", names)
+    assert line == "; last evaluation 5.50 rotations (net_turns 0.25, travelled_turns 3.50), best 6.00 at 1.0 M"
+    assert headline_so_far(rounds[:1], "rotations", names) == "; last evaluation 6.00 rotations, best 6.00 at 1.0 M"
