@@ -21,7 +21,9 @@ import numpy as np
 import torch
 
 from roto.envs.control import target_to_action
+from roto.envs.observations import ball_positions
 from roto.envs.roto_env import RotoEnv
+from roto.eval.ball_paths import BALL_GROUP
 from roto.reference.baoding_cost import BaodingCostWeights, baoding_rollout_cost
 from roto.reference.predictive_sampling import PredictiveSampling, SamplingConfig
 from roto.registry import make
@@ -91,10 +93,12 @@ def run_reference_episode(
     """One episode of the controller's env (reset here); records into ``preswap`` the states
     ``leads`` control steps before each swap.
 
-    Returns the episode's swaps, rotations, return, length and seconds of wall time.
+    Returns the episode's swaps, rotations, return, length, seconds of wall time, and the task's
+    path metrics (the pair's net and travelled turns: whether the balls went round each other).
     """
     env = controller.env
-    env.reset()
+    obs, _ = env.reset()
+    path = [ball_positions(obs[BALL_GROUP], len(env.balls))[0]]  # the balls after each step, (n_ball, 3)
     controller.start()
     history: deque[tuple[np.ndarray, np.ndarray, bool, np.ndarray]] = deque(maxlen=max(leads))
     start = time.perf_counter()
@@ -107,10 +111,10 @@ def run_reference_episode(
                 env.task_state.latched[0].numpy().copy(),
             )
         )
-        _, _, terminated, truncated, info = env.step(controller.act())
+        obs, _, terminated, truncated, info = env.step(controller.act())
         if preswap is not None and float(info["reward_terms"]["swap"][0]) > 0:
             preswap.record(history, leads)
-        if bool(terminated[0] | truncated[0]):
+        if bool(terminated[0] | truncated[0]):  # obs is the next episode's first: the path ends before it
             episode = info["episode"]
             return {
                 "swaps": float(episode["swaps"][0]),
@@ -118,7 +122,9 @@ def run_reference_episode(
                 "return": float(episode["r"][0]),
                 "length": int(episode["l"][0]),
                 "seconds": time.perf_counter() - start,
+                **env.task.path_metrics(torch.stack(path)),
             }
+        path.append(ball_positions(obs[BALL_GROUP], len(env.balls))[0])
 
 
 def _cost(
@@ -138,8 +144,10 @@ def _cost(
 
 def reference_env(robot: str, seed: int, episode_steps: int = 600, **options: object) -> RotoEnv:
     """The one-world Baoding env the reference controller plays (benchmark settings, unless
-    ``options`` change them: e.g. ``replay_starts`` to start from recorded states)."""
-    return make("baoding", robot=robot, num_envs=1, seed=seed, obs_mode="blind", episode_steps=episode_steps, **options)
+    ``options`` change them: e.g. ``replay_starts`` to start from recorded states), also returning
+    the balls' state for the path metrics."""
+    config = {"obs_mode": "blind", "episode_steps": episode_steps, "extra_groups": (BALL_GROUP,), **options}
+    return make("baoding", robot=robot, num_envs=1, seed=seed, **config)
 
 
 def save_preswap_states(path, robot: str, states: PreswapStates) -> None:
@@ -208,6 +216,7 @@ def run_reference_baoding(
         "min_rotations": float(rotations.min()),
         "max_rotations": float(rotations.max()),
         "mean_swaps": float(2.0 * rotations.mean()),
+        **{f"mean_{name}": float(np.mean([r[name] for r in per_episode])) for name in env.task.path_metric_names},
         "mean_length": float(np.mean([r["length"] for r in per_episode])),
         "seconds_per_episode": float(np.mean([r["seconds"] for r in per_episode])),
         "preswap_states": len(preswap.physics),

@@ -12,6 +12,7 @@ from roto.reference.baoding_controller import (
     PreswapStates,
     reference_env,
     run_reference_baoding,
+    run_reference_episode,
     save_preswap_states,
 )
 from roto.reference.baoding_cost import BaodingCostWeights
@@ -49,6 +50,19 @@ def test_from_a_recorded_preswap_state_the_controller_swaps_again(seed):
     controller.planner.close()
     env.close()
     assert swaps == 1
+
+
+def test_a_reference_episode_reports_the_turns_of_the_ball_pair_over_its_own_steps():
+    """The path metrics of a short episode started just before a swap: the pair turns while it swaps."""
+    env = reference_env("shadow", seed=0, episode_steps=30, replay_starts=str(PRESWAP), replay_share=1.0)
+    controller = controller_for(env)
+    try:
+        result = run_reference_episode(controller)
+    finally:
+        controller.planner.close()
+        env.close()
+    assert result["length"] == 30 and result["swaps"] >= 1
+    assert 0.0 < result["net_turns"] <= result["travelled_turns"] + 1e-12
 
 
 def test_the_controller_needs_one_world_on_the_cpu():
