@@ -2,14 +2,15 @@
 # Pack roto's simulation packages for an offline GPU machine (x86-64 Linux, Python 3.12) into parts
 # that fit a transfer limit: warp-lang (168 MB as a wheel) unpacked without its examples and
 # compressed with xz (104 MB), the other wheels as they are, split into DIR/part1 .. DIR/partN of at
-# most PART_MIB MiB each (default 54: a 64 MiB transfer that also carries the source tree, about 8 MiB).
+# most PART_MIB MiB each (default 48: a 64 MiB transfer that also carries the source tree, about 11 MiB
+# and growing with the results it keeps).
 #   usage: benchmarks/gpu_wheels.sh DIR [PART_MIB]
 # On the GPU machine, with every part's files copied into one folder W:
 #   cd W && cat warp.tar.xz.part-* | tar -xJf - -C SITE && pip install --no-index --no-deps --target SITE *.whl
 # then run roto from its source tree with PYTHONPATH=SITE:$PWD (docs/backends.md).
 set -euo pipefail
 out=${1:?usage: benchmarks/gpu_wheels.sh DIR [PART_MIB]}
-part_mib=${2:-54}
+part_mib=${2:-48}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 download() {  # wheels for CPython 3.12 on x86-64 manylinux, without their dependencies
