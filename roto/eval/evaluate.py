@@ -8,9 +8,9 @@ from typing import Any
 
 import torch
 
+from roto.envs.ball_paths import first_episodes_with_paths, for_path_metrics
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
-from roto.eval.ball_paths import first_episodes_with_paths, for_path_metrics
 from roto.rl.networks import ActorCritic
 from roto.rl.settings import TrainSettings
 from roto.rl.torch_threads import single_torch_thread

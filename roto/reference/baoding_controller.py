@@ -20,10 +20,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
+from roto.envs.ball_paths import BALL_GROUP
 from roto.envs.control import target_to_action
 from roto.envs.observations import ball_positions
 from roto.envs.roto_env import RotoEnv
-from roto.eval.ball_paths import BALL_GROUP
 from roto.reference.baoding_cost import BaodingCostWeights, baoding_rollout_cost
 from roto.reference.predictive_sampling import PredictiveSampling, SamplingConfig
 from roto.registry import make

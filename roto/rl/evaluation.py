@@ -15,7 +15,7 @@ from typing import Any
 
 import torch
 
-from roto.eval.ball_paths import first_episodes_with_paths
+from roto.envs.ball_paths import first_episodes_with_paths
 from roto.result_files import write_text_atomic
 from roto.rl.networks import ActorCritic
 from roto.rl.torch_threads import single_torch_thread

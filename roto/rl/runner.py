@@ -16,10 +16,10 @@ from typing import Any
 import torch
 from tqdm import tqdm
 
+from roto.envs.ball_paths import for_path_metrics
 from roto.envs.config import EnvConfig
 from roto.envs.episodes import readable
 from roto.envs.roto_env import RotoEnv
-from roto.eval.ball_paths import for_path_metrics
 from roto.rl.build import build_learner, build_model, extra_groups, stacked_sizes
 from roto.rl.checkpoints import load_checkpoint, save_checkpoint
 from roto.rl.config import AgentConfig, to_dict
