@@ -20,9 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
-from roto.envs.ball_paths import BALL_GROUP
+from roto.envs.ball_paths import BALL_GROUP, BallPathRecorder
 from roto.envs.control import target_to_action
-from roto.envs.observations import ball_positions
 from roto.envs.roto_env import RotoEnv
 from roto.reference.baoding_cost import BaodingCostWeights, baoding_rollout_cost
 from roto.reference.predictive_sampling import PredictiveSampling, SamplingConfig
@@ -98,7 +97,7 @@ def run_reference_episode(
     """
     env = controller.env
     obs, _ = env.reset()
-    path = [ball_positions(obs[BALL_GROUP], len(env.balls))[0]]  # the balls after each step, (n_ball, 3)
+    act = BallPathRecorder(lambda _: controller.act(), len(env.balls))  # keeps the balls' path as it acts
     controller.start()
     history: deque[tuple[np.ndarray, np.ndarray, bool, np.ndarray]] = deque(maxlen=max(leads))
     start = time.perf_counter()
@@ -111,20 +110,20 @@ def run_reference_episode(
                 env.task_state.latched[0].numpy().copy(),
             )
         )
-        obs, _, terminated, truncated, info = env.step(controller.act())
+        obs, _, terminated, truncated, info = env.step(act(obs))
         if preswap is not None and float(info["reward_terms"]["swap"][0]) > 0:
             preswap.record(history, leads)
-        if bool(terminated[0] | truncated[0]):  # obs is the next episode's first: the path ends before it
+        if bool(terminated[0] | truncated[0]):
             episode = info["episode"]
+            paths = act.path_metrics(env.task, episode["l"])  # the episode's own observations
             return {
                 "swaps": float(episode["swaps"][0]),
                 "rotations": float(episode["rotations"][0]),
                 "return": float(episode["r"][0]),
                 "length": int(episode["l"][0]),
                 "seconds": time.perf_counter() - start,
-                **env.task.path_metrics(torch.stack(path)),
+                **{name: values[0] for name, values in paths.items()},
             }
-        path.append(ball_positions(obs[BALL_GROUP], len(env.balls))[0])
 
 
 def _cost(
