@@ -3,8 +3,10 @@
 # started from the Shadow's configuration (enqueued as its first trial), at the CPU Olympiad's
 # budget of 5 M env steps, then exported as the hand's packaged config roto/configs/bounce_cpu_<hand>.yaml
 # (a diff from bounce_cpu_quickstart). Two one-thread workers; about 16 trials x 40 minutes / 2 per
-# hand, fewer when pruned. Rerunning continues where it stopped: a finished study has its trials
-# (and interrupted trials are retried from their checkpoints, --reclaim-now: no other worker runs).
+# hand, fewer when pruned. Each study's journal lives in benchmarks/results/sweeps/<study>.journal.log
+# (commit it after a sitting), so rerunning continues where it stopped, on this machine or on a new
+# clone: finished trials stay finished, and interrupted ones are retried (--reclaim-now: no other
+# worker runs) from their checkpoints where runs/ still has them, from their start where not.
 #     bash benchmarks/bounce_sweeps.sh [hand ...]      (default: shadow_lite allegro orca)
 set -euo pipefail
 hands=("$@")
@@ -12,9 +14,11 @@ hands=("$@")
 mkdir -p benchmarks/results/sweeps
 for robot in "${hands[@]}"; do
     study="bounce_cpu_$robot"
+    journal="benchmarks/results/sweeps/$study.journal.log"
     roto sweep --study "$study" --task bounce --robot "$robot" --obs blind \
         --agent_cfg bounce_cpu_quickstart --space cpu_quickstart --steps 5000000 --trials 16 --startup 4 \
-        --enqueue_base --num_envs 128 --threads 1 --torch_threads 1 --workers 2 --reclaim-now
-    roto sweep show --study "$study" > "benchmarks/results/sweeps/$study.md"
-    roto sweep export --study "$study" --out "roto/configs/bounce_cpu_$robot.yaml"
+        --enqueue_base --num_envs 128 --threads 1 --torch_threads 1 --workers 2 --reclaim-now \
+        --storage "$journal"
+    roto sweep show --study "$study" --storage "$journal" > "benchmarks/results/sweeps/$study.md"
+    roto sweep export --study "$study" --storage "$journal" --out "roto/configs/bounce_cpu_$robot.yaml"
 done

@@ -7,6 +7,8 @@ import json
 import pathlib
 from typing import TYPE_CHECKING
 
+from roto.sweep.command import STORAGE_HELP
+
 if TYPE_CHECKING:
     from roto.olympiad.plan import Plan
 
@@ -17,7 +19,7 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("plan", help="a packaged plan (cpu, paper) or a plan YAML file")
     p.add_argument("--root", default="runs/olympiad", help="where run directories go (<root>/<plan>/<cell>)")
     p.add_argument("--results", default=None, help="folder of the cells' summaries (default <root>/<plan>/results)")
-    p.add_argument("--storage", default=None, help="database URL (e.g. postgresql://...); default: journal file")
+    p.add_argument("--storage", default=None, help=STORAGE_HELP)
     p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
     p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running cell's heartbeats")
     p.add_argument("--reclaim-now", "--reclaim_now", dest="reclaim_now", action="store_true",

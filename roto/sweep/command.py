@@ -6,6 +6,8 @@ import argparse
 import json
 import sys
 
+STORAGE_HELP = "database URL (postgresql://...) or a journal file's path (*.log); default: <root>/<study>/journal.log"
+
 RUN_FLAGS = ("task", "robot", "obs", "agent_cfg", "space", "objective", "trials", "startup", "steps", "warmup_steps",
              "num_envs", "threads", "root", "storage", "heartbeat")  # fmt: skip
 """The ``SweepSettings`` fields the command line sets (besides the study name and overrides)."""
@@ -14,7 +16,7 @@ RUN_FLAGS = ("task", "robot", "obs", "agent_cfg", "space", "objective", "trials"
 def _study_args(parser: argparse.ArgumentParser, required: bool) -> None:
     parser.add_argument("--study", required=required, help="study name (its folder: <root>/<study>)")
     parser.add_argument("--root", default="runs/sweeps", help="folder of the studies' folders (default runs/sweeps)")
-    parser.add_argument("--storage", default=None, help="database URL (e.g. postgresql://...); default: journal file")
+    parser.add_argument("--storage", default=None, help=STORAGE_HELP)
 
 
 def add_sweep_parser(sub: argparse._SubParsersAction) -> None:

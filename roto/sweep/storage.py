@@ -1,8 +1,10 @@
 """Where a study lives, and how a dead worker's trial is found and retried.
 
 Storage: Optuna's journal file in the study's folder by default (processes on one machine, or
-machines sharing a filesystem), or any database URL Optuna accepts (``postgresql://...``:
-workers on many machines join one study by running the same command).
+machines sharing a filesystem); a journal file elsewhere, named by its path (``*.log``: kept with
+the results and committed, it carries a study's finished trials to a machine that starts empty);
+or any database URL Optuna accepts (``postgresql://...``: workers on many machines join one study
+by running the same command).
 
 Liveness: a worker's running trial carries a heartbeat (a system attribute with the time, written
 every ``interval`` seconds by a thread). Before each new trial, a worker marks every running
@@ -72,33 +74,53 @@ def database_url(url: str) -> str:
     return f"postgresql+psycopg2://{rest}" if scheme == "postgresql" and sep and only_psycopg2 else url
 
 
+def journal_path(url: str) -> pathlib.Path | None:
+    """The journal file ``url`` names (a path ending in ``.log``), or None for a database URL.
+
+    Raises:
+        ValueError naming ``url`` when it is neither ``scheme://...`` nor a ``*.log`` path.
+    """
+    if "://" in url:
+        return None
+    if not url.endswith(".log"):
+        raise ValueError(
+            f"storage {url!r} is neither a database URL (e.g. postgresql://user@host/db, sqlite:///file.db) "
+            f"nor a journal file's path (ending in .log)"
+        )
+    return pathlib.Path(url)
+
+
 def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.storages.BaseStorage:
-    """The journal file in ``study_dir`` (created), or the database at ``url``.
+    """The journal file in ``study_dir`` (created), the journal file ``url`` names (``*.log``,
+    created), or the database at ``url``.
 
     A database storage retries calls across a lost connection (``RetryingStorage``); the journal
     drops a torn last line before writing (``JournalFile``).
 
     Raises:
         ValueError naming the URL (password hidden) when the database cannot be reached in
-        ``CONNECT_TIMEOUT_S`` or refuses the connection.
+        ``CONNECT_TIMEOUT_S`` or refuses the connection, or when ``url`` is neither a URL nor a
+        ``*.log`` path.
     """
-    if url:
-        driver_url = database_url(url)
-        engine = {"pool_pre_ping": True}  # a connection the server dropped is replaced, not used
-        if driver_url.startswith("postgresql"):
-            engine["connect_args"] = {"connect_timeout": CONNECT_TIMEOUT_S}
-        try:
-            database = optuna.storages.RDBStorage(driver_url, engine_kwargs=engine)
-        except sqlalchemy.exc.SQLAlchemyError as error:
-            raise ValueError(f"cannot open the storage {redact_url(url)!r}: {first_line(error)}") from None
-        return RetryingStorage(database, redact_url(url))
-    study_dir.mkdir(parents=True, exist_ok=True)
-    return JournalStorage(JournalFile(str(study_dir / JOURNAL_NAME)))
+    journal = journal_path(url) if url else study_dir / JOURNAL_NAME
+    if journal is not None:
+        journal.parent.mkdir(parents=True, exist_ok=True)
+        return JournalStorage(JournalFile(str(journal)))
+    driver_url = database_url(url)
+    engine = {"pool_pre_ping": True}  # a connection the server dropped is replaced, not used
+    if driver_url.startswith("postgresql"):
+        engine["connect_args"] = {"connect_timeout": CONNECT_TIMEOUT_S}
+    try:
+        database = optuna.storages.RDBStorage(driver_url, engine_kwargs=engine)
+    except sqlalchemy.exc.SQLAlchemyError as error:
+        raise ValueError(f"cannot open the storage {redact_url(url)!r}: {first_line(error)}") from None
+    return RetryingStorage(database, redact_url(url))
 
 
 def find_study(folder: pathlib.Path, name: str, url: str | None = None) -> optuna.Study | None:
     """Study ``name`` in ``folder``'s journal (or the database at ``url``) if it exists; creates nothing."""
-    if url is None and not (folder / JOURNAL_NAME).is_file():
+    journal = journal_path(url) if url else folder / JOURNAL_NAME
+    if journal is not None and not journal.is_file():
         return None
     storage = open_storage(folder, url)
     names = [s.study_name for s in optuna.get_all_study_summaries(storage, include_best_trial=False)]

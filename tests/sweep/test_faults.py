@@ -2,6 +2,7 @@
 
 import multiprocessing
 import time
+from dataclasses import replace
 
 import optuna
 import pytest
@@ -195,3 +196,30 @@ def test_a_live_trial_declared_dead_is_left_to_its_retry_which_continues_its_run
     assert first.state == TrialState.FAIL and retry.state in FINISHED and retry.system_attrs["failed_trial"] == 0
     steps = [r["env_steps"] for r in read_evaluations(run_dir_of(settings, 0))]
     assert steps == sorted(set(steps)) and steps[-1] == settings.steps  # one run, continued to its end
+
+
+def test_a_study_in_a_journal_file_carried_to_an_empty_machine_keeps_its_trials_and_retries_the_rest(tmp_path, capsys):
+    from roto.sweep.report import show
+
+    torch.set_num_threads(1)
+    journal = tmp_path / "results" / "toy.log"  # committed with the results; run directories are not
+    first = replace(toy_settings(tmp_path, trials=1, updates=2, storage=str(journal)), root=str(tmp_path / "machine_a"))
+    assert run_worker(first, env_factory=ToyEnv) == 1
+    claim_as_dead_workers(first, 1)  # a trial still training when the first machine went away
+    assert journal.is_file() and not (first.study_dir / JOURNAL_NAME).exists()
+
+    second = replace(first, trials=2, root=str(tmp_path / "machine_b"))
+    assert run_worker(second, env_factory=ToyEnv, reclaim=True) == 1
+    assert "reclaimed running trials [1]" in capsys.readouterr().out
+    study = optuna.load_study(study_name=first.study, storage=open_storage(tmp_path, str(journal)))
+    assert [t.state for t in study.trials] == [TrialState.COMPLETE, TrialState.FAIL, TrialState.COMPLETE]
+    assert read_evaluations(run_dir_of(second, 1))  # the retry trained from scratch on the new machine
+    assert not read_evaluations(run_dir_of(second, 0))  # the finished trial is not trained again
+    assert show(first.study, str(tmp_path / "elsewhere"), str(journal)).count("| complete |") == 2
+
+
+@pytest.mark.parametrize("storage", ["runs/toy", "journal.txt", "postgres"])
+def test_a_storage_that_is_neither_a_url_nor_a_journal_file_is_refused_by_name(tmp_path, storage):
+    with pytest.raises(ValueError, match=rf"storage '{storage}' is neither a database URL .* nor a journal file"):
+        open_storage(tmp_path, storage)
+    assert not (tmp_path / storage).exists()
