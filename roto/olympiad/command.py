@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import pathlib
 from typing import TYPE_CHECKING
@@ -24,6 +25,8 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running cell's heartbeats")
     p.add_argument("--reclaim-now", "--reclaim_now", dest="reclaim_now", action="store_true",
                    help="first fail and retry every running cell (only when no other worker is alive)")  # fmt: skip
+    p.add_argument("--threads", type=int, default=None,
+                   help="C threads stepping each worker's envs (default: the plan's; not part of a cell)")
     p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
     p.add_argument("--dry-run", "--dry_run", dest="dry_run", action="store_true",
                    help="list the cells, which are done, and the time left; train nothing")  # fmt: skip
@@ -49,6 +52,10 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     from roto.sweep.storage import reclaim_now
 
     plan = load_plan(args.plan)  # checked before anything runs or is written
+    if args.threads is not None:
+        if args.threads < 1:
+            raise ValueError(f"--threads must be >= 1, got {args.threads}")
+        plan = dataclasses.replace(plan, threads=args.threads)
     results = _results_dir(args, plan.name)
     if args.dry_run:
         if args.workers < 1:
@@ -64,7 +71,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
             reclaim_now(study, storage)
         enqueue_missing(study, plan, results)
         argv = [args.plan, "--root", args.root, "--results", str(results), "--heartbeat", str(args.heartbeat),
-                "--torch_threads", str(args.torch_threads)]  # fmt: skip
+                "--torch_threads", str(args.torch_threads), "--threads", str(plan.threads)]  # fmt: skip
         argv += ["--storage", args.storage] if args.storage else []
         return launch_workers("olympiad", args.workers, argv)
     torch.set_num_threads(args.torch_threads)

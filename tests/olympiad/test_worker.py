@@ -5,6 +5,7 @@ import signal
 import time
 
 import optuna
+import yaml
 from optuna.trial import TrialState
 
 from roto.olympiad.plan import load_plan
@@ -159,7 +160,7 @@ def test_cli_olympiad_with_two_workers_on_the_real_env_then_results(tmp_path, ca
         "grids:\n  - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0]}\n"
     )
     root = tmp_path / "runs"
-    assert main(["olympiad", str(plan_path), "--root", str(root), "--workers", "2"]) == 0
+    assert main(["olympiad", str(plan_path), "--root", str(root), "--workers", "2", "--threads", "2"]) == 0
     study = load_study(root, load_plan(str(plan_path)))
     assert len(study.get_trials(states=(TrialState.COMPLETE,))) == 2
     # the command enqueued the cells before starting its workers: none was enqueued twice
@@ -172,3 +173,13 @@ def test_cli_olympiad_with_two_workers_on_the_real_env_then_results(tmp_path, ca
     assert summary["final"]["episodes"] == 2 and "bounces_mean" in summary["best"]
     assert main(["results", str(plan_path), "--root", str(root), "--out", str(tmp_path / "out")]) == 0
     assert "| allegro | " in (tmp_path / "out" / "results.md").read_text()
+    for cell in ("bounce-shadow-blind-ppo-seed0", "bounce-allegro-blind-ppo-seed0"):  # the plan's default is 1
+        assert yaml.safe_load((root / "real" / cell / "config.yaml").read_text())["train"]["env"]["threads"] == 2
+
+
+def test_cli_olympiad_refuses_a_thread_count_below_one_by_value(tmp_path, capsys):
+    from roto.cli import main
+
+    assert main(["olympiad", "cpu", "--root", str(tmp_path), "--threads", "0"]) == 2
+    assert "--threads must be >= 1, got 0" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
