@@ -25,12 +25,8 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running cell's heartbeats")
     p.add_argument("--reclaim-now", "--reclaim_now", dest="reclaim_now", action="store_true",
                    help="first fail and retry every running cell (only when no other worker is alive)")  # fmt: skip
-    p.add_argument(
-        "--threads",
-        type=int,
-        default=None,
-        help="C threads stepping each worker's envs (default: the plan's; not part of a cell)",
-    )
+    p.add_argument("--threads", type=int, default=None,
+                   help="C threads stepping each worker's envs (default: the plan's; not part of a cell)")  # fmt: skip
     p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
     p.add_argument("--dry-run", "--dry_run", dest="dry_run", action="store_true",
                    help="list the cells, which are done, and the time left; train nothing")  # fmt: skip
