@@ -90,6 +90,12 @@ def journal_path(url: str) -> pathlib.Path | None:
     return pathlib.Path(url)
 
 
+def journal_of(study_dir: pathlib.Path, url: str | None) -> pathlib.Path | None:
+    """The journal file a study with folder ``study_dir`` and storage ``url`` lives in (the folder's
+    own without ``url``), or None when ``url`` is a database."""
+    return journal_path(url) if url else study_dir / JOURNAL_NAME
+
+
 def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.storages.BaseStorage:
     """The journal file in ``study_dir`` (created), the journal file ``url`` names (``*.log``,
     created), or the database at ``url``.
@@ -102,7 +108,7 @@ def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.stor
         ``CONNECT_TIMEOUT_S`` or refuses the connection, or when ``url`` is neither a URL nor a
         ``*.log`` path.
     """
-    journal = journal_path(url) if url else study_dir / JOURNAL_NAME
+    journal = journal_of(study_dir, url)
     if journal is not None:
         journal.parent.mkdir(parents=True, exist_ok=True)
         return JournalStorage(JournalFile(str(journal)))
@@ -119,7 +125,7 @@ def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.stor
 
 def find_study(folder: pathlib.Path, name: str, url: str | None = None) -> optuna.Study | None:
     """Study ``name`` in ``folder``'s journal (or the database at ``url``) if it exists; creates nothing."""
-    journal = journal_path(url) if url else folder / JOURNAL_NAME
+    journal = journal_of(folder, url)
     if journal is not None and not journal.is_file():
         return None
     storage = open_storage(folder, url)
