@@ -219,6 +219,7 @@ class RotoEnv:
             "starts": self._starts.state_dict(),
             "nonfinite_resets": self.nonfinite_resets,
             "needs_reset": self._needs_reset,
+            "since_check": self._since_check,
             **({"replay_bank": self.replay_bank.state_dict()} if self.replay_bank is not None else {}),
             **({"event_recorder": self.recorder.state_dict()} if self.recorder is not None else {}),
             **({"tolerance_curriculum": self.curriculum.state_dict()} if self.curriculum is not None else {}),
@@ -248,9 +249,12 @@ class RotoEnv:
             self.curriculum.load_state_dict(state["tolerance_curriculum"])
         self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
-        if not self._needs_reset:  # the pool covers the steps until the next check (same draws, earlier)
-            self._starts.ensure(self.check_every * self.num_envs)
-        self._since_check = 0
+        if "since_check" in state:  # the pool as saved covers the steps until the next check, as it did there
+            self._since_check = int(state["since_check"])
+        else:  # saved without it: top the pool up now (the same draws, earlier, so not bit-identical where
+            self._since_check = 0  # what a draw returns changes meanwhile, as a bank of recorded states does)
+            if not self._needs_reset:
+                self._starts.ensure(self.check_every * self.num_envs)
 
     @property
     def nonfinite_resets(self) -> int:

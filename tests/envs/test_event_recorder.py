@@ -189,6 +189,34 @@ def test_a_resumed_env_records_and_draws_as_the_original(tmp_path):
     assert torch.equal(first._draw_starts(32)["qpos"], second._draw_starts(32)["qpos"])
 
 
+def test_a_resumed_env_draws_its_starts_when_the_original_does_from_the_states_recorded_by_then(tmp_path):
+    """Saved with a pool too small for every world to reset: loading must not top it up, or the
+    resumed env would draw from fewer recorded states than the original later does."""
+    from roto.scripted import ScriptedBounce
+
+    first = recording_env(own_bank(tmp_path / "bank.npz"), replay_share=0.9)
+    policy = ScriptedBounce(first)
+    obs, _ = first.reset()
+    for _ in range(400):  # the scripted policy bounces: events to record; drops: resets
+        obs, _, terminated, truncated, _ = first.step(policy(obs))
+        policy.reset(terminated | truncated)
+        if 0 < first._starts.remaining < WORLDS and first.recorder.recorded > 0:
+            break
+    assert 0 < first._starts.remaining < WORLDS
+    second = recording_env(own_bank(tmp_path / "other.npz"), replay_share=0.9, seed=7)
+    second.load_state_dict(first.state_dict())
+    recorded, drew_after_new_states = int(first.recorder.recorded), False
+    for _ in range(600):
+        left, action = first._starts.remaining, policy(obs)
+        obs, _, terminated, truncated, _ = first.step(action)
+        obs_b, *_ = second.step(action)
+        assert all(torch.equal(obs[k], obs_b[k]) for k in obs)
+        policy.reset(terminated | truncated)
+        drew_after_new_states |= first._starts.remaining > left and int(first.recorder.recorded) > recorded
+    assert drew_after_new_states
+    assert torch.equal(first.recorder.bank["qpos"], second.recorder.bank["qpos"])
+
+
 def test_recording_needs_replayed_starts_and_evaluation_never_records():
     from roto.envs.config import EnvConfig
     from roto.rl.settings import TrainSettings
