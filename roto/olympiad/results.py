@@ -86,11 +86,12 @@ def cell_statistics(scores: np.ndarray, seed: int = 0) -> dict[str, float]:
 
 
 def improvements(scores: dict[Key, np.ndarray]) -> list[tuple[str, str, str, str, str, float]]:
-    """(task, robot, obs, variant x, variant y, P(x > y)) for every pair of variants of a setting."""
+    """(task, robot, obs, variant x, variant y, P(x > y)) for every pair of variants of a setting
+    that both have at least two seeds (one run against one run is a comparison, not a probability)."""
     out = []
     for (task, robot, obs, x), sx in scores.items():
         for (task_y, robot_y, obs_y, y), sy in scores.items():
-            if (task, robot, obs) == (task_y, robot_y, obs_y) and x < y:
+            if (task, robot, obs) == (task_y, robot_y, obs_y) and x < y and min(sx.size, sy.size) >= 2:
                 out.append((task, robot, obs, x, y, probability_of_improvement(sx[:, None], sy[:, None])))
     return out
 
@@ -140,6 +141,8 @@ def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None, 
 def _format(stats: dict | None) -> str:
     if stats is None:
         return ""
+    if stats["n"] == 1:  # one seed: no spread, and an IQM or interval of one value says nothing more
+        return f"{stats['mean']:.1f} (n=1)"
     interval = f"[{stats['iqm_low']:.1f}, {stats['iqm_high']:.1f}]"
     return f"{stats['mean']:.1f} ± {stats['std']:.1f} (IQM {stats['iqm']:.1f} {interval}, n={stats['n']})"
 
@@ -233,7 +236,7 @@ def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str
     md += path_metric_table(summaries)
     pairs = improvements(scores_by_cell(summaries, "final"))
     if pairs:
-        md += ["## Probability of improvement (final policies)", ""]
+        md += ["## Probability of improvement (final policies; variants with two or more seeds)", ""]
         md += [f"- {t} / {r} / {o}: P({x} > {y}) = {p:.2f}" for t, r, o, x, y, p in pairs]
     write_text_atomic(out / "results.md", "\n".join(md) + "\n")
     plots = plot_curves(summaries, out, label)

@@ -59,6 +59,20 @@ def test_results_match_hand_computed_statistics(tmp_path, capsys):
     assert not (out / "action_std_bounce_shadow.png").exists()
 
 
+def test_one_seed_gets_no_spread_and_no_probability_of_improvement(tmp_path):
+    from roto.olympiad.results import write_results
+
+    write_summaries(tmp_path / "summaries")
+    one = json.loads((tmp_path / "summaries" / "baoding-allegro-blind-ppo-seed0.json").read_text())
+    one.update(variant="fd", agent=AGENTS["fd"], final={"rotations_mean": 3.0}, best={"rotations_mean": 3.0})
+    (tmp_path / "summaries" / "baoding-allegro-blind-fd-seed0.json").write_text(json.dumps(one))
+    write_results(tmp_path / "summaries", tmp_path / "out")
+    md = (tmp_path / "out" / "results.md").read_text()
+    assert "| 3.0 (n=1) |" in md and "| 1.5 (n=1) |" in md and "IQM 1.5" not in md
+    assert "baoding / allegro" not in md.split("## Probability of improvement")[1]  # one seed each
+    assert "bounce / shadow / blind: P(fd > ppo) = 0.62" in md  # two seeds against four: still a probability
+
+
 def test_results_of_a_folder_without_summaries_is_a_clear_error(tmp_path, capsys):
     assert main(["results", str(tmp_path), "--out", str(tmp_path / "out")]) == 2
     assert "no cell summaries" in capsys.readouterr().err
@@ -85,7 +99,7 @@ def test_no_roto_v1_row_where_no_column_is_roto_agent():
 
     scores = {("baoding", "shadow", "blind", "recipe"): np.array([10.0])}
     plain = markdown_table(scores, {("baoding", "recipe"): {"label": "baoding_cpu + aids"}}, {"baoding"})
-    assert "roto v1" not in plain and "| shadow | 10.0 ± 0.0" in plain
+    assert "roto v1" not in plain and "| shadow | 10.0 (n=1) |" in plain
     roto = markdown_table(scores, {("baoding", "recipe"): {"label": "roto's", "roto_agent": "ppo"}}, {"baoding"})
     assert "| roto v1, Shadow, 200 M steps (5 seeds) | 5.1 (ppo) |  |" in roto
 
