@@ -15,6 +15,7 @@ def test_packaged_plans():
         "baoding_v1_ablations",
         "baoding_v1_more_aids",
         "baoding_v1_shadow_more_aids",
+        "bounce_long_shadow",
     }
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
@@ -25,6 +26,9 @@ def test_packaged_plans():
         f"bounce-shadow-{obs}-ppo-seed{s}" for obs in ("state", "proprio") for s in (0, 1)
     }
     assert [c.seed for c in cpu.cells] == sorted(c.seed for c in cpu.cells)  # every first seed before a second
+    long = load_plan("bounce_long_shadow")
+    assert [c.name for c in long.cells] == [f"bounce-shadow-blind-quickstart-seed{s}" for s in (0, 1)]
+    assert long.steps == 20_000_000 and long.variants["quickstart"].agent_for("bounce") == ("bounce_cpu_quickstart", [])
     paper = load_plan("paper")
     assert len(paper.cells) == 4 * 2 * 2 * 5 and paper.steps == 200_000_000 and paper.backend == "warp"
 
