@@ -249,10 +249,10 @@ class RotoEnv:
             self.curriculum.load_state_dict(state["tolerance_curriculum"])
         self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
-        if "since_check" in state:  # the pool as saved covers the steps until the next check, as it did there
-            self._since_check = int(state["since_check"])
-        else:  # saved without it: top the pool up now (the same draws, earlier, so not bit-identical where
-            self._since_check = 0  # what a draw returns changes meanwhile, as a bank of recorded states does)
+        if "starts" in state and "since_check" in state:  # the pool as saved covers the steps until the next
+            self._since_check = int(state["since_check"])  # check, as it did in the env that saved it
+        else:  # saved by an older roto: top the pool up now (the same draws, earlier, so not bit-identical
+            self._since_check = 0  # where what a draw returns changes meanwhile, as a bank of recorded states)
             if not self._needs_reset:
                 self._starts.ensure(self.check_every * self.num_envs)
 

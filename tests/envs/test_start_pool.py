@@ -115,7 +115,7 @@ def test_checkpoint_saved_before_pooling_loads_and_draws_fresh_starts():
     env = make_env("bounce", num_envs=4, seed=3)
     env.reset()
     state = env.state_dict()
-    del state["starts"]  # what envs saved before episode starts were pooled
+    del state["starts"], state["since_check"]  # what envs saved before episode starts were pooled
     env.step(torch.zeros(4, 20))
     assert env._starts.remaining == 0  # reset() used all four starts
     env._starts.take(1)  # leave leftovers that the load must drop
