@@ -16,6 +16,7 @@ def test_packaged_plans():
         "baoding_v1_more_aids",
         "baoding_v1_shadow_more_aids",
         "bounce_long_shadow",
+        "baoding_v1_low_noise",
     }
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
@@ -280,6 +281,23 @@ def test_each_ablation_changes_exactly_its_part_of_the_baoding_recipe():
     assert [c.variant for c in plan.cells] == list(expected)
     for variant, changes in expected.items():
         assert cell_spec(plan, Cell("baoding", "shadow", "blind", variant, 1)).differences(recipe) == changes, variant
+
+
+def test_the_low_noise_plan_trains_orcas_recipe_on_other_hands_as_the_ablation_did_on_the_shadow():
+    """Each cell is ORCA's Olympiad recipe on its hand at 5 M; the Shadow's seed 1 is the ablation's low_noise cell."""
+    from roto.olympiad.cell import cell_spec
+
+    plan, main, ablations = (load_plan(n) for n in ("baoding_v1_low_noise", "baoding_v1_cpu", "baoding_v1_ablations"))
+    variant = "task_critic_more_aids_low_noise"
+    assert plan.variants[variant] == main.variants[variant] and plan.steps == ablations.steps == 5_000_000
+    assert [(c.robot, c.seed) for c in plan.cells] == [
+        ("shadow", 0), ("shadow_lite", 0), ("shadow_lite", 1), ("orca", 1), ("shadow", 1)
+    ]  # fmt: skip
+    shadow = cell_spec(plan, Cell("baoding", "shadow", "blind", variant, 1))
+    assert shadow.differences(cell_spec(ablations, Cell("baoding", "shadow", "blind", "low_noise", 1))) == {}
+    for cell in plan.cells:
+        spec = cell_spec(plan, cell)
+        assert spec.env.replay_starts.endswith(f"{cell.robot}_preswap.npz") and spec.agent.network.max_log_std == -1.386
 
 
 def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_starts():
