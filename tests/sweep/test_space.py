@@ -26,7 +26,9 @@ def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load
     bank = "benchmarks/results/baoding_reference/shadow_preswap.npz"
     baoding = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu",
                          [f"env.replay_starts={bank}", "env.replay_share=0.25"])  # fmt: skip
-    assert [p.key for p in baoding.parameters] == [*(p.key for p in plain.parameters), "env.replay_share"]
+    assert [p.key for p in baoding.parameters] == [
+        *(p.key for p in plain.parameters), "network.max_log_std", "env.replay_share"
+    ]  # fmt: skip
     with pytest.raises(ValueError, match=r"replay_share 0\.1 needs replay_starts"):  # the bank is the study's to set
         load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu")
     recipe = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu_shadow")  # its own bank
