@@ -218,20 +218,20 @@ def test_the_low_noise_variant_differs_from_all_three_only_in_the_policy_std():
 
 
 @pytest.mark.parametrize(
-    ("robot", "variant"),
+    ("plan_name", "robot", "variant"),
     [
-        ("shadow", "task_critic_more_aids"),
-        ("shadow_lite", "task_critic_more_aids"),
-        ("allegro", "task_critic_more_aids"),
-        ("orca", "task_critic_more_aids_low_noise"),
+        ("baoding_v1_low_noise", "shadow", "task_critic_more_aids_low_noise"),
+        ("baoding_v1_cpu", "shadow_lite", "task_critic_more_aids"),
+        ("baoding_v1_cpu", "allegro", "task_critic_more_aids"),
+        ("baoding_v1_cpu", "orca", "task_critic_more_aids_low_noise"),
     ],
 )
-def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(robot, variant):
+def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(plan_name, robot, variant):
     """``roto train --agent_cfg baoding_cpu_<hand>`` is the recipe behind the hand's Baoding result."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
-    plan = load_plan("baoding_v1_cpu")
+    plan = load_plan(plan_name)
     cell = cell_spec(plan, Cell("baoding", robot, "blind", variant, 0))
     config = f"baoding_cpu_{robot}"
     packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=1)
