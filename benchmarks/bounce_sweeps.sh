@@ -8,6 +8,7 @@
 # clone: finished trials stay finished, and interrupted ones are retried (--reclaim-now: no other
 # worker runs) from their checkpoints where runs/ still has them, from their start where not.
 #     bash benchmarks/bounce_sweeps.sh [hand ...]      (default: shadow_lite allegro orca)
+#     WORKERS=1 bash benchmarks/bounce_sweeps.sh shadow_lite   (one worker, beside another job)
 set -euo pipefail
 hands=("$@")
 [[ ${#hands[@]} -gt 0 ]] || hands=(shadow_lite allegro orca)
@@ -17,7 +18,7 @@ for robot in "${hands[@]}"; do
     journal="benchmarks/results/sweeps/$study.journal.log"
     roto sweep --study "$study" --task bounce --robot "$robot" --obs blind \
         --agent_cfg bounce_cpu_quickstart --space cpu_quickstart --steps 5000000 --trials 16 --startup 4 \
-        --enqueue_base --num_envs 128 --threads 1 --torch_threads 1 --workers 2 --reclaim-now \
+        --enqueue_base --num_envs 128 --threads 1 --torch_threads 1 --workers "${WORKERS:-2}" --reclaim-now \
         --storage "$journal"
     roto sweep show --study "$study" --storage "$journal" > "benchmarks/results/sweeps/$study.md"
     roto sweep export --study "$study" --storage "$journal" --out "roto/configs/bounce_cpu_$robot.yaml"
