@@ -78,9 +78,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.enqueue_base:  # before any worker draws a trial
         space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
-        inside, outside = enqueue_base(open_study(settings)[0], settings, space)
-        print(f"enqueued the base config as the first trial: {inside}"
-              + (f"; outside the space, drawn instead: {outside}" if outside else ""), file=sys.stderr)  # fmt: skip
+        study = open_study(settings)[0]
+        if study.trials:  # the same command that started the study continues it
+            print(f"--enqueue_base: study {settings.study!r} already has {len(study.trials)} trials, so the base "
+                  "config (only ever a new study's first trial) is not enqueued again; continuing the study",
+                  file=sys.stderr)  # fmt: skip
+        else:
+            inside, outside = enqueue_base(study, settings, space)
+            print(f"enqueued the base config as the first trial: {inside}"
+                  + (f"; outside the space, drawn instead: {outside}" if outside else ""), file=sys.stderr)  # fmt: skip
     if args.workers > 1:
         load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)  # before creating
         study, storage = open_study(settings)  # create it once, so the workers only join

@@ -257,6 +257,23 @@ def test_cli_workers_run_a_study_on_the_real_env_and_show_it(tmp_path, capsys):
     assert head in out and "| ppo.lr | reason |" in out
 
 
+def test_the_command_that_enqueued_the_base_continues_its_study_without_enqueueing_it_again(tmp_path, capsys):
+    from roto.cli import main
+
+    space = toy_settings(tmp_path, trials=2).space  # writes the toy space file
+    fixed = [arg for override in TOY_OVERRIDES for arg in ("--set", override)]
+    args = ["sweep", "--study", "again", "--root", str(tmp_path), "--space", space, "--startup", "1",
+            "--steps", "16", "--num_envs", "2", "--enqueue_base", *fixed]  # fmt: skip
+    assert main([*args, "--trials", "1"]) == 0
+    assert "enqueued the base config as the first trial" in capsys.readouterr().err
+    assert main([*args, "--trials", "2"]) == 0  # a rerun (a new sitting) with the same flags
+    assert "already has 1 trials, so the base config" in capsys.readouterr().err
+    trials = optuna.load_study(study_name="again", storage=open_storage(tmp_path / "again")).get_trials()
+    assert [t.state for t in trials] == [TrialState.COMPLETE, TrialState.COMPLETE]
+    assert trials[0].params["ppo.lr"] == load_agent_config("bounce").ppo.lr  # the base, once
+    assert trials[1].params["ppo.lr"] != trials[0].params["ppo.lr"]  # drawn, not the base again
+
+
 def test_a_bad_space_with_several_workers_is_refused_before_the_study_exists(tmp_path, capsys):
     from roto.cli import main
 
