@@ -15,9 +15,11 @@ hands=("$@")
 mkdir -p benchmarks/results/sweeps
 for robot in "${hands[@]}"; do
     study="bounce_cpu_$robot"
+    space=cpu_quickstart  # ORCA's random actions already bounce the ball: its space also searches the initial noise
+    [[ $robot == orca ]] && space=cpu_quickstart_noise
     journal="benchmarks/results/sweeps/$study.journal.log"
     roto sweep --study "$study" --task bounce --robot "$robot" --obs blind \
-        --agent_cfg bounce_cpu_quickstart --space cpu_quickstart --steps 5000000 --trials 16 --startup 4 \
+        --agent_cfg bounce_cpu_quickstart --space "$space" --steps 5000000 --trials 16 --startup 4 \
         --enqueue_base --num_envs 128 --threads 1 --torch_threads 1 --workers "${WORKERS:-2}" --reclaim-now \
         --storage "$journal"
     roto sweep show --study "$study" --storage "$journal" > "benchmarks/results/sweeps/$study.md"

@@ -14,7 +14,7 @@ def write_space(tmp_path, text):
 
 
 def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load_for_their_configs():
-    assert set(packaged_spaces()) == {"roto2", "roto1", "cpu_quickstart", "baoding_cpu"}
+    assert set(packaged_spaces()) == {"roto2", "roto1", "cpu_quickstart", "cpu_quickstart_noise", "baoding_cpu"}
     plain = load_space("roto2", ENV, "bounce")
     assert [p.key for p in plain.parameters] == [
         "ppo.rollouts", "ppo.minibatches", "ppo.epochs", "ppo.lr", "ppo.entropy_coef", "ppo.value_coef",
@@ -23,6 +23,9 @@ def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load
     assert len(load_space("roto1", ENV, "bounce").parameters) == 9
     quick = load_space("cpu_quickstart", ENV, "bounce_cpu_quickstart")
     assert [p.key for p in quick.parameters] == [p.key for p in plain.parameters]  # the same seven, narrower
+    orca = EnvConfig(task="bounce", robot="orca", num_envs=8)
+    noise = load_space("cpu_quickstart_noise", orca, "bounce_cpu_quickstart")
+    assert noise.parameters[:7] == quick.parameters and noise.parameters[7].key == "network.init_log_std"
     bank = "benchmarks/results/baoding_reference/shadow_preswap.npz"
     baoding = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu",
                          [f"env.replay_starts={bank}", "env.replay_share=0.25"])  # fmt: skip
@@ -74,7 +77,8 @@ def test_a_bad_space_is_rejected_naming_the_key_and_the_valid_choices(tmp_path, 
 
 
 def test_an_unknown_space_name_lists_the_packaged_ones():
-    with pytest.raises(FileNotFoundError, match=r"'roto3'.*\['baoding_cpu', 'cpu_quickstart', 'roto1', 'roto2'\]"):
+    names = r"\['baoding_cpu', 'cpu_quickstart', 'cpu_quickstart_noise', 'roto1', 'roto2'\]"
+    with pytest.raises(FileNotFoundError, match=r"'roto3'.*" + names):
         load_space("roto3", ENV)
 
 
