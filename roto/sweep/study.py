@@ -11,6 +11,7 @@ from typing import Any
 import optuna
 
 from roto.envs.config import EnvConfig
+from roto.sweep.pruner import MedianBestSoFarPruner
 from roto.sweep.storage import JOURNAL_NAME, find_study, open_storage, redact_url
 
 STUDY_NAME = re.compile(r"[A-Za-z0-9._-]+")
@@ -102,7 +103,7 @@ def open_study(settings: SweepSettings) -> tuple[optuna.Study, optuna.storages.B
     # constant liar: parallel workers' running trials count as bad, so they do not all sample the same region
     sampler = optuna.samplers.TPESampler(multivariate=True, n_startup_trials=settings.startup, constant_liar=True)
     warmup = settings.warmup_steps if settings.warmup_steps is not None else settings.steps // 5
-    pruner = optuna.pruners.MedianPruner(n_startup_trials=settings.startup, n_warmup_steps=warmup)
+    pruner = MedianBestSoFarPruner(n_startup_trials=settings.startup, n_warmup_steps=warmup)
     study = optuna.create_study(
         study_name=settings.study,
         storage=storage,
