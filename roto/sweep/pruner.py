@@ -3,8 +3,8 @@
 A trial reports its best evaluation so far after each evaluation, at its env steps. Trials that
 roll out 16, 32 or 64 steps per update (or evaluate at another interval) report at different env
 steps, so Optuna's ``MedianPruner``, which compares only reports at exactly the same step, judged
-a trial at most of its evaluations against the few finished trials that happened to share its
-grid (often one). Here each finished trial counts with its last report at or before the pruned
+a trial at most of its evaluations against the few complete trials that happened to share its
+grid (often one). Here each complete trial counts with its last report at or before the judged
 trial's env steps: the best it had reached by then.
 """
 
