@@ -16,6 +16,7 @@ TRAINING_AID_FIELDS = (
     "replay_record_capacity",
     "tolerance_start",
     "tolerance_target",
+    "swap_min_turn",
 )
 """The env fields that are training aids: a run's training envs may set them; evaluation and the
 benchmark never do (``EnvConfig.without_training_aids``)."""
@@ -64,6 +65,11 @@ class EnvConfig:
             headline metric rises (``roto.envs.tolerance_curriculum``).
         tolerance_target: the headline metric per training episode (Baoding: rotations) at which
             the radius is the task's own.
+        swap_min_turn: a training aid for Baoding (0: off): a swap earns its reward only when the
+            line from one ball to the other has turned at least this many turns since the last
+            paid swap, the same way round as the episode's first (0.25: a quarter turn; a pair
+            carried round turns half a turn a swap, one swung out and back is paid once an
+            episode). Swaps still count as roto counts them (``roto.tasks.round_swaps``).
     """
 
     task: str
@@ -90,6 +96,7 @@ class EnvConfig:
     replay_record_capacity: int = 1024
     tolerance_start: float = 0.0
     tolerance_target: float = 1.0
+    swap_min_turn: float = 0.0
 
     def __post_init__(self) -> None:
         """Reject impossible values with a message naming the value and the valid choices."""
@@ -124,6 +131,7 @@ class EnvConfig:
                 raise ValueError(f"{name} must be an integer >= 1 or None, got {value!r}")
         self._check_replay()
         self._check_tolerance()
+        self._check_swap_min_turn()
         self._check_device()
 
     def without_training_aids(self) -> EnvConfig:
@@ -166,6 +174,15 @@ class EnvConfig:
                 f"tolerance_start must be at least the task's own radius {own} m and tolerance_target > 0, "
                 f"got {start}, {target}"
             )
+
+    def _check_swap_min_turn(self) -> None:
+        from roto.tasks import get_task
+
+        value = self.swap_min_turn
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 0.5:
+            raise ValueError(f"swap_min_turn must be a number of turns in [0, 0.5] (0: off), got {value!r}")
+        if value > 0.0 and not getattr(get_task(self.task), "round_swaps_aid", False):
+            raise ValueError(f"swap_min_turn applies to a task with swaps (baoding); task {self.task!r} has none")
 
     def _check_device(self) -> None:
         device = str(self.device)

@@ -98,6 +98,8 @@ class RotoEnv:
         self._replayed_task_fields = tuple(self.replay_bank.task) if replaying else ()
         self.recorder = event_recorder_for(self)  # None unless the config records its own events
         self.curriculum = tolerance_curriculum_for(self)  # None unless the config widens the task's radius
+        if config.swap_min_turn > 0.0:  # training only: pay only the swaps that follow a turn (roto.tasks.round_swaps)
+            self.task_state.min_turn.fill_(config.swap_min_turn)
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)

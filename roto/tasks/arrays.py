@@ -64,3 +64,11 @@ def as_dtype_of(x: Array, like: Array) -> Array:
     if isinstance(x, np.ndarray):
         return x.astype(like.dtype)
     return x.to(like.dtype)
+
+
+def atan2(y: Array, x: Array) -> Array:
+    """Elementwise angle of (x, y) in [-pi, pi]. A numpy array goes through torch's CPU kernel
+    (sharing its memory), for the same bits on both."""
+    if isinstance(y, np.ndarray):
+        return torch.atan2(torch.from_numpy(y), torch.from_numpy(x)).numpy()
+    return torch.atan2(y, x)

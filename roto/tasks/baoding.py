@@ -14,6 +14,7 @@ from roto.sim.scene import BallSpec, build_scene
 from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where
 from roto.tasks.base import PALM_DROP_LIMIT, Marker, StepResult, TaskInputs, clear_where, uniform
 from roto.tasks.pair_turns import pair_turns
+from roto.tasks.round_swaps import paid_swaps, pair_turn_step
 
 BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
@@ -98,6 +99,12 @@ class BaodingState:
     latched: torch.Tensor  # (B, 2) bool: ball i has reached its current target
     swaps: torch.Tensor  # (B,) int64
     radius: torch.Tensor  # () float64: the success radius (SUCCESS_RADIUS; a training curriculum may widen it)
+    # the round-swaps training aid (roto.tasks.round_swaps); min_turn 0 (the benchmark) pays every swap
+    pair_angle: torch.Tensor  # (B,) float64: the ball line's angle (rad) at the last step
+    angle_set: torch.Tensor  # (B,) bool: pair_angle holds a value this episode
+    turned: torch.Tensor  # (B,) float64: the line's signed turns since the last paid swap
+    direction: torch.Tensor  # (B,) float64: +1 or -1, the way round of the first paid swap; 0 before it
+    min_turn: torch.Tensor  # () float64: turns a paid swap must follow (0: every swap is paid)
 
 
 def baoding_rule(
@@ -136,6 +143,8 @@ class Baoding:
     version = 1
     """v1: balls dropped from above, roto's diagonal (or side-by-side) targets; v0 started the balls
     on targets where they rest, partly inside the hand."""
+    round_swaps_aid = True
+    """Has the training-only round-swaps aid (``EnvConfig.swap_min_turn``, ``roto.tasks.round_swaps``)."""
     metric_names = ("swaps", "rotations")
     headline_metric = "rotations"
     success_radius = SUCCESS_RADIUS
@@ -165,12 +174,17 @@ class Baoding:
             latched=torch.zeros(num_envs, 2, dtype=torch.bool, device=device),
             swaps=torch.zeros(num_envs, dtype=torch.int64, device=device),
             radius=torch.tensor(SUCCESS_RADIUS, dtype=torch.float64, device=device),
+            pair_angle=torch.zeros(num_envs, dtype=torch.float64, device=device),
+            angle_set=torch.zeros(num_envs, dtype=torch.bool, device=device),
+            turned=torch.zeros(num_envs, dtype=torch.float64, device=device),
+            direction=torch.zeros(num_envs, dtype=torch.float64, device=device),
+            min_turn=torch.zeros((), dtype=torch.float64, device=device),
         )
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:
-        """Clear the latches, swap count and assignment (ball a -> T_a, ball b -> T_b) of the worlds
-        in ``mask`` (B,) bool."""
-        for latch in (state.swapped, state.latched, state.swaps):
+        """Clear the latches, swap count and assignment (ball a -> T_a, ball b -> T_b), and the ball
+        line's turns, of the worlds in ``mask`` (B,) bool."""
+        for latch in (state.swapped, state.latched, state.swaps, state.angle_set, state.turned, state.direction):
             clear_where(latch, mask)
 
     def initial_ball_positions(self, state: BaodingState, n: int, generator: torch.Generator) -> torch.Tensor:
@@ -180,18 +194,22 @@ class Baoding:
         return state.drop[None] + offset
 
     def step(self, state: BaodingState, inputs: TaskInputs) -> StepResult:
-        """Latch, swap (+10), dense shaping; end when the balls part or drop."""
+        """Latch, swap (+10; with the round-swaps aid, only a swap that followed a turn), dense
+        shaping; end when the balls part or drop."""
         pos = inputs.ball_pos
         dist, swap, state.swapped, state.latched = baoding_rule(
             pos, state.targets, state.swapped, state.latched, state.radius
         )
         state.swaps += swap
+        state.pair_angle, turn = pair_turn_step(pos, state.pair_angle, state.angle_set)
+        state.angle_set = state.angle_set | True
+        paid, state.turned, state.direction = paid_swaps(swap, state.turned + turn, state.direction, state.min_turn)
         dense = DENSE_SCALE * (1.0 - tanh(dist / DENSE_LENGTH)).sum(axis=1)
         parted = squared_norm(pos[:, 0] - pos[:, 1]) >= MAX_SEPARATION**2
         dropped = (pos[:, :, 2] < -PALM_DROP_LIMIT).any(axis=1)
         terminated = parted | dropped
         return StepResult(
-            reward_terms={"swap": SWAP_REWARD * as_dtype_of(swap, pos), "distance": dense}, terminated=terminated
+            reward_terms={"swap": SWAP_REWARD * as_dtype_of(paid, pos), "distance": dense}, terminated=terminated
         )
 
     def metrics(self, state: BaodingState) -> dict[str, torch.Tensor]:

@@ -17,6 +17,7 @@ def test_packaged_plans():
         "baoding_v1_shadow_more_aids",
         "bounce_long_shadow",
         "baoding_v1_low_noise",
+        "baoding_v1_round",
     }
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]

@@ -80,3 +80,13 @@ def test_squared_norm_gives_the_same_bits_without_torch(components):
     v, t = both(np.random.default_rng(3).normal(size=(B, 2, components)))
     assert_same(squared_norm(v), squared_norm(t))
     np.testing.assert_allclose(squared_norm(v), (v**2).sum(axis=-1), rtol=1e-15)
+
+
+def test_atan2_gives_the_same_bits_and_agrees_with_numpys():
+    from roto.tasks.arrays import atan2
+
+    rng = np.random.default_rng(3)
+    y, y_t = both(rng.normal(size=B))
+    x, x_t = both(rng.normal(size=B))
+    assert_same(atan2(y, x), atan2(y_t, x_t))
+    np.testing.assert_allclose(atan2(y, x), np.arctan2(y, x), rtol=1e-14)
