@@ -72,3 +72,12 @@ def atan2(y: Array, x: Array) -> Array:
     if isinstance(y, np.ndarray):
         return torch.atan2(torch.from_numpy(y), torch.from_numpy(x)).numpy()
     return torch.atan2(y, x)
+
+
+def zero_on_host(x: Array) -> bool:
+    """Whether ``x`` is zero everywhere, where reading it costs nothing: a numpy array or a CPU
+    tensor. A tensor on another device is never read (that would wait for the device): False, so
+    the caller takes the path that is right for any value."""
+    if isinstance(x, np.ndarray):
+        return not x.any()
+    return x.device.type == "cpu" and not bool(x.any())

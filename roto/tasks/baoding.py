@@ -11,7 +11,7 @@ import torch
 
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
-from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where
+from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where, zero_on_host
 from roto.tasks.base import PALM_DROP_LIMIT, Marker, StepResult, TaskInputs, clear_where, uniform
 from roto.tasks.pair_turns import pair_turns
 from roto.tasks.round_swaps import paid_swaps, pair_turn_step
@@ -201,9 +201,12 @@ class Baoding:
             pos, state.targets, state.swapped, state.latched, state.radius
         )
         state.swaps += swap
-        state.pair_angle, turn = pair_turn_step(pos, state.pair_angle, state.angle_set)
-        state.angle_set = state.angle_set | True
-        paid, state.turned, state.direction = paid_swaps(swap, state.turned + turn, state.direction, state.min_turn)
+        if zero_on_host(state.min_turn):  # the benchmark: every swap is paid (the aid's state stays idle)
+            paid = swap
+        else:
+            state.pair_angle, turn = pair_turn_step(pos, state.pair_angle, state.angle_set)
+            state.angle_set = state.angle_set | True
+            paid, state.turned, state.direction = paid_swaps(swap, state.turned + turn, state.direction, state.min_turn)
         dense = DENSE_SCALE * (1.0 - tanh(dist / DENSE_LENGTH)).sum(axis=1)
         parted = squared_norm(pos[:, 0] - pos[:, 1]) >= MAX_SEPARATION**2
         dropped = (pos[:, :, 2] < -PALM_DROP_LIMIT).any(axis=1)

@@ -90,3 +90,12 @@ def test_atan2_gives_the_same_bits_and_agrees_with_numpys():
     x, x_t = both(rng.normal(size=B))
     assert_same(atan2(y, x), atan2(y_t, x_t))
     np.testing.assert_allclose(atan2(y, x), np.arctan2(y, x), rtol=1e-14)
+
+
+def test_zero_on_host_reads_numpy_and_cpu_tensors_only():
+    from roto.tasks.arrays import zero_on_host
+
+    assert zero_on_host(np.zeros(())) and not zero_on_host(np.full((), 0.25))
+    assert zero_on_host(torch.zeros(())) and not zero_on_host(torch.tensor([0.0, 0.25]))
+    if torch.cuda.is_available():  # never read on a device: the caller's general path
+        assert not zero_on_host(torch.zeros((), device="cuda"))
