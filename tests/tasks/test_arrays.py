@@ -97,5 +97,10 @@ def test_zero_on_host_reads_numpy_and_cpu_tensors_only():
 
     assert zero_on_host(np.zeros(())) and not zero_on_host(np.full((), 0.25))
     assert zero_on_host(torch.zeros(())) and not zero_on_host(torch.tensor([0.0, 0.25]))
-    if torch.cuda.is_available():  # never read on a device: the caller's general path
-        assert not zero_on_host(torch.zeros((), device="cuda"))
+
+
+@pytest.mark.gpu
+def test_zero_on_host_never_reads_a_device_tensor():
+    from roto.tasks.arrays import zero_on_host
+
+    assert not zero_on_host(torch.zeros((), device="cuda"))  # the caller's path that is right for any value
