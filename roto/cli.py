@@ -86,8 +86,10 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         return _demo_baoding(args)
     from roto.scripted import run_scripted_bounce
 
-    if args.preswap_out is not None or args.preswap_leads is not None:
-        raise ValueError("--preswap_out and --preswap_leads are for --task baoding (the Bounce script makes no swaps)")
+    if args.preswap_out is not None or args.preswap_leads is not None or args.turn_weight is not None:
+        raise ValueError(
+            "--preswap_out, --preswap_leads and --turn_weight are for --task baoding (the Bounce script makes no swaps)"
+        )
     stats = run_scripted_bounce(
         robot=args.robot,
         num_envs=args.num_envs,
@@ -105,6 +107,7 @@ def _demo_baoding(args: argparse.Namespace) -> int:
     import pathlib
 
     from roto.reference.baoding_controller import PRESWAP_LEAD, run_reference_baoding
+    from roto.reference.baoding_cost import BaodingCostWeights
 
     if args.preswap_leads is not None and args.preswap_out is None:
         raise ValueError(f"--preswap_leads {args.preswap_leads} records states for --preswap_out; give that file too")
@@ -121,6 +124,7 @@ def _demo_baoding(args: argparse.Namespace) -> int:
         preswap_path=out,
         preswap_leads=tuple(args.preswap_leads or (PRESWAP_LEAD,)),
         progress=True,
+        weights=BaodingCostWeights(turn=args.turn_weight or 0.0),
     )
     print(json.dumps(stats))
     return 0
@@ -344,6 +348,16 @@ def _add_demo_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="Baoding: the control steps before each swap at which --preswap_out records a state (default: 10, "
         "1/6 s; e.g. 10 20 30 40 50 60: the last second before each swap, back past the swap before it)",
+    )
+    p_demo.add_argument(
+        "--turn_weight",
+        "--turn-weight",
+        dest="turn_weight",
+        type=float,
+        default=None,
+        help="Baoding: weight of the turn the balls' axis still has to go counter-clockwise (seen from above) in "
+        "the planner's cost, so that it carries the balls round one way instead of swinging them (default: 0, "
+        "off: roto's swap rule has no direction)",
     )
     p_demo.set_defaults(func=_cmd_demo)
 

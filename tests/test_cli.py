@@ -38,7 +38,9 @@ def test_baoding_demo_refuses_what_the_reference_controller_cannot_do(capsys, tm
     assert main(["demo", "--task", "baoding", "--preswap_out", str(missing)]) == 2
     assert f"directory {str(missing.parent)!r} does not exist" in capsys.readouterr().err
     assert main(["demo", "--task", "bounce", "--preswap_out", str(tmp_path / "s.npz")]) == 2
-    assert "--preswap_out and --preswap_leads are for --task baoding" in capsys.readouterr().err
+    assert "--preswap_out, --preswap_leads and --turn_weight are for --task baoding" in capsys.readouterr().err
+    assert main(["demo", "--task", "bounce", "--turn_weight", "3"]) == 2
+    assert "--turn_weight are for --task baoding" in capsys.readouterr().err
     assert main(["demo", "--task", "baoding", "--preswap_leads", "10", "20"]) == 2
     assert "--preswap_leads [10, 20] records states for --preswap_out" in capsys.readouterr().err
     assert main(["demo", "--task", "baoding", "--episodes", "0"]) == 2

@@ -28,6 +28,11 @@ class BaodingCostWeights:
         action_rate: per rad² of change of the joint targets between control steps (mean).
         floor: height (m, task frame) below which a ball counts as falling.
         max_separation: distance (m) between the balls above which they count as parting.
+        turn: per turn that the pair's axis still has to go, counter-clockwise seen from above
+            (about the task frame's z, in the plane through the target axis nearest the horizontal),
+            to reach its target axis, averaged like ``distance``. ``angle`` and ``distance`` have no
+            direction, so the planner may swing the balls out and back; this term makes it carry
+            them round one way. 0 (the default): off.
     """
 
     distance: float = 10.0
@@ -37,6 +42,12 @@ class BaodingCostWeights:
     action_rate: float = 0.02
     floor: float = -0.06
     max_separation: float = 0.12
+    turn: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name, value in vars(self).items():
+            if not np.isfinite(value):
+                raise ValueError(f"BaodingCostWeights.{name} must be finite, got {value!r}")
 
 
 def baoding_rollout_cost(
@@ -76,6 +87,8 @@ def baoding_rollout_cost(
     cos = (axis @ goal) / (np.linalg.norm(axis, axis=-1) * np.linalg.norm(goal) + 1e-9)
     angle = np.arccos(np.clip(cos, -1.0, 1.0))
     per_step = weights.distance * (dist * ~latch).sum(-1) + weights.angle * angle
+    if weights.turn:
+        per_step = per_step + weights.turn * turn_to_go(axis, goal)
     scored = np.maximum(before.sum(axis=1), 1)
     cost = (per_step * before).sum(axis=1) / scored
     cost -= weights.swap * swaps * (horizon - first) / horizon
@@ -85,3 +98,25 @@ def baoding_rollout_cost(
     rate = np.diff(joint_targets, axis=1)
     cost += weights.action_rate * (rate**2).sum(-1).mean(-1)
     return cost
+
+
+def turn_to_go(axis: np.ndarray, goal: np.ndarray) -> np.ndarray:
+    """Turns (in [0, 1)) that ``axis`` still has to rotate counter-clockwise, seen from above, to
+    point along ``goal``: about the normal of the plane through ``goal`` nearest the horizontal.
+
+    Args:
+        axis: (..., 3) the pair's axis (ball a -> ball b).
+        goal: (3,) the target axis (not vertical).
+
+    Returns:
+        (...,) turns to go; an axis just past the goal has almost a whole turn to go.
+    """
+    up = np.array([0.0, 0.0, 1.0])
+    unit = goal / np.linalg.norm(goal)
+    normal = up - (up @ unit) * unit
+    size = np.linalg.norm(normal)
+    if size < 1e-6:
+        raise ValueError(f"target axis {goal.tolist()} is vertical: no plane nearest the horizontal")
+    normal /= size
+    signed = np.arctan2(np.cross(axis, goal) @ normal, axis @ goal)  # rotation from axis to goal about normal
+    return np.mod(signed, 2 * np.pi) / (2 * np.pi)

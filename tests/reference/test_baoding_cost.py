@@ -2,8 +2,9 @@
 latched balls and falling balls are scored as documented."""
 
 import numpy as np
+import pytest
 
-from roto.reference.baoding_cost import BaodingCostWeights, baoding_rollout_cost
+from roto.reference.baoding_cost import BaodingCostWeights, baoding_rollout_cost, turn_to_go
 
 TARGETS = np.array([[0.0, 0.0, 0.0], [0.03, 0.0, 0.02]])
 H = 10
@@ -72,3 +73,58 @@ def test_jerky_targets_cost_more():
     joint_targets[1, ::2] = 0.5
     smooth, jerky = cost(pos, joint_targets=joint_targets)
     assert jerky > smooth
+
+
+def rotate_about_z(vector, turns):
+    c, s = np.cos(2 * np.pi * turns), np.sin(2 * np.pi * turns)
+    return np.array([c * vector[0] - s * vector[1], s * vector[0] + c * vector[1], vector[2]])
+
+
+def test_turn_to_go_counts_the_counter_clockwise_way_round():
+    goal = np.array([0.03, 0.0, 0.0])
+    axes = np.stack([rotate_about_z(goal, t) for t in (0.0, -0.25, 0.25, -0.5, 0.01)])
+    np.testing.assert_allclose(turn_to_go(axes, goal), [0.0, 0.25, 0.75, 0.5, 0.99], atol=1e-12)
+
+
+def test_turn_to_go_in_a_tilted_plane():
+    """The Shadow's diagonal targets: the goal axis climbs; turning about the normal of the plane
+    through it nearest the horizontal still counts a quarter turn as a quarter."""
+    goal = np.array([1.0, 1.0, 1.0])
+    up = np.array([0.0, 0.0, 1.0])
+    normal = up - (up @ goal) / (goal @ goal) * goal
+    normal /= np.linalg.norm(normal)
+    behind = np.cross(normal, goal)  # the goal rotated a quarter turn counter-clockwise about the normal
+    assert abs(normal[0]) > 0.3  # the plane is tilted away from the horizontal
+    axes = np.stack([-behind, behind, -goal, goal])
+    np.testing.assert_allclose(turn_to_go(axes, goal), [0.25, 0.75, 0.5, 0.0], atol=1e-12)
+
+
+def test_turn_to_go_refuses_a_vertical_goal():
+    with pytest.raises(ValueError, match="vertical"):
+        turn_to_go(np.ones((1, 3)), np.array([0.0, 0.0, 0.04]))
+
+
+def test_the_turn_weight_makes_going_round_counter_clockwise_cheaper():
+    """Two rollouts, mirror images: one carries the pair a quarter turn counter-clockwise, the other
+    clockwise, neither reaching the targets. Without the turn term they cost the same; with it the
+    counter-clockwise one is cheaper."""
+    centre = (TARGETS[0] + TARGETS[1]) / 2
+    half = (TARGETS[1] - TARGETS[0]) / 2
+    start = rotate_about_z(half, 0.5)  # ball a where ball b's target is: half a turn to go either way
+    paths = []
+    for sign in (1, -1):
+        paths.append(
+            [
+                (centre - rotate_about_z(start, sign * k / 40), centre + rotate_about_z(start, sign * k / 40))
+                for k in range(H)
+            ]
+        )
+    no_turn = cost(rollouts(*paths))
+    np.testing.assert_allclose(no_turn[0], no_turn[1], rtol=0, atol=1e-12)
+    ccw, cw = cost(rollouts(*paths), weights=BaodingCostWeights(turn=1.0))
+    assert ccw < cw
+
+
+def test_cost_weights_refuse_non_finite_values():
+    with pytest.raises(ValueError, match="turn"):
+        BaodingCostWeights(turn=float("nan"))
