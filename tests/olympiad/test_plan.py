@@ -311,6 +311,25 @@ def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_st
     assert pathlib.Path(bank).is_file()
 
 
+def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
+    """Each cell is ORCA's packaged recipe with the round-swap aid, the round controller's bank, or both."""
+    from roto.olympiad.cell import cell_spec
+    from roto.rl.run_spec import build_run_spec
+
+    plan = load_plan("baoding_v1_round")
+    recipe = build_run_spec("baoding", "orca", "blind", "baoding_cpu_orca", [], plan.steps, num_envs=128, threads=1)
+    bank, round_bank = recipe.env.replay_starts, "benchmarks/results/baoding_reference/orca_round_preswap.npz"
+    expected = {
+        "round_swaps": {"env.swap_min_turn": (0.25, 0.0)},
+        "round_bank": {"env.replay_starts": (round_bank, bank)},
+        "round_bank_round_swaps": {"env.replay_starts": (round_bank, bank), "env.swap_min_turn": (0.25, 0.0)},
+    }
+    assert [c.variant for c in plan.cells] == list(expected)
+    for cell in plan.cells:
+        assert cell_spec(plan, cell).differences(recipe) == expected[cell.variant]
+    assert pathlib.Path(round_bank).is_file()
+
+
 def test_the_busiest_worker_and_a_running_cells_rate():
     from roto.olympiad.command import busiest_worker_steps, recent_rate
 
