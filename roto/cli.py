@@ -113,6 +113,8 @@ def _demo_baoding(args: argparse.Namespace) -> int:
         raise ValueError(f"--preswap_leads {args.preswap_leads} records states for --preswap_out; give that file too")
     if args.backend != "cpu":
         raise ValueError(f"backend {args.backend!r}: the Baoding reference controller plans on 'cpu' only")
+    if args.turn_weight is not None and not args.turn_weight >= 0:
+        raise ValueError(f"--turn_weight {args.turn_weight}: must be a weight >= 0 (0: off, no direction)")
     out = pathlib.Path(args.preswap_out) if args.preswap_out else None
     if out is not None and not out.parent.is_dir():
         raise FileNotFoundError(f"--preswap_out: directory {str(out.parent)!r} does not exist")

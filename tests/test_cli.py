@@ -41,6 +41,8 @@ def test_baoding_demo_refuses_what_the_reference_controller_cannot_do(capsys, tm
     assert "--preswap_out, --preswap_leads and --turn_weight are for --task baoding" in capsys.readouterr().err
     assert main(["demo", "--task", "bounce", "--turn_weight", "3"]) == 2
     assert "--turn_weight are for --task baoding" in capsys.readouterr().err
+    assert main(["demo", "--task", "baoding", "--turn_weight", "-2"]) == 2
+    assert "--turn_weight -2.0: must be a weight >= 0" in capsys.readouterr().err
     assert main(["demo", "--task", "baoding", "--preswap_leads", "10", "20"]) == 2
     assert "--preswap_leads [10, 20] records states for --preswap_out" in capsys.readouterr().err
     assert main(["demo", "--task", "baoding", "--episodes", "0"]) == 2

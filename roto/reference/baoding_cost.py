@@ -48,6 +48,8 @@ class BaodingCostWeights:
         for name, value in vars(self).items():
             if not np.isfinite(value):
                 raise ValueError(f"BaodingCostWeights.{name} must be finite, got {value!r}")
+        if self.turn < 0:
+            raise ValueError(f"BaodingCostWeights.turn must be >= 0 (0: off), got {self.turn!r}")
 
 
 def baoding_rollout_cost(

@@ -126,5 +126,7 @@ def test_the_turn_weight_makes_going_round_counter_clockwise_cheaper():
 
 
 def test_cost_weights_refuse_non_finite_values():
-    with pytest.raises(ValueError, match="turn"):
+    with pytest.raises(ValueError, match="turn must be finite, got nan"):
         BaodingCostWeights(turn=float("nan"))
+    with pytest.raises(ValueError, match=r"turn must be >= 0 \(0: off\), got -1.0"):
+        BaodingCostWeights(turn=-1.0)
