@@ -47,3 +47,19 @@ def test_baoding_demo_refuses_what_the_reference_controller_cannot_do(capsys, tm
     assert "--preswap_leads [10, 20] records states for --preswap_out" in capsys.readouterr().err
     assert main(["demo", "--task", "baoding", "--episodes", "0"]) == 2
     assert "episodes must be an integer >= 1, got 0" in capsys.readouterr().err
+
+
+def test_baoding_demo_passes_the_turn_weight_to_the_planner(capsys, monkeypatch):
+    import roto.reference.baoding_controller as controller
+
+    seen = {}
+
+    def fake_run(**kwargs):
+        seen.update(kwargs)
+        return {"mean_rotations": 0.0}
+
+    monkeypatch.setattr(controller, "run_reference_baoding", fake_run)
+    assert main(["demo", "--task", "baoding", "--robot", "orca", "--turn_weight", "3"]) == 0
+    assert seen["robot"] == "orca" and seen["weights"].turn == 3.0 and seen["weights"].distance == 10.0
+    assert main(["demo", "--task", "baoding"]) == 0
+    assert seen["weights"].turn == 0.0  # off unless asked: the published figures' cost
