@@ -8,32 +8,13 @@ import json
 import sys
 from collections.abc import Sequence
 
+from roto.cli_args import add_env_args, add_touch_arg
+from roto.cli_demo import add_demo_parser
 from roto.cli_errors import check_output_file, error_exit
 from roto.olympiad.command import add_olympiad_parsers
 from roto.rl.config_help import HelpConfigAction
 from roto.rl.stop_requests import interrupt_on_sigterm
 from roto.sweep.command import add_sweep_parser
-
-
-def _add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
-    parser.add_argument("--task", default="bounce", help="task name: bounce, baoding (default: bounce)")
-    parser.add_argument("--robot", default="shadow", help="robot name (default: shadow)")
-    parser.add_argument("--num_envs", "--num-envs", dest="num_envs", type=int, default=num_envs)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--threads", type=int, default=1, help="C threads stepping the worlds (CPU backend)")
-    parser.add_argument("--backend", default="cpu", help="physics backend: cpu (default) or warp (MuJoCo Warp)")
-    parser.add_argument("--device", default="cpu", help="cpu (default), or cuda[:k] with --backend warp")
-    parser.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; no effect")
-
-
-def _add_touch_arg(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--touch",
-        default="binary",
-        help="tactile signal: binary (a touch bit per link, the benchmark's; default), force "
-        "(log(1 + |F| / 0.1 N) of each link's net contact force) or taxels (the link bits, then a bit "
-        "per taxel of the fingertip pads and the palm)",
-    )
 
 
 def _cmd_list(args: argparse.Namespace) -> int:
@@ -75,60 +56,6 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     else:
         for key, value in result.items():
             print(f"{key:>24}: {value}")
-    return 0
-
-
-def _cmd_demo(args: argparse.Namespace) -> int:
-    from roto.registry import get_task
-
-    task = get_task(args.task).name
-    if task == "baoding":
-        return _demo_baoding(args)
-    from roto.scripted import run_scripted_bounce
-
-    if args.preswap_out is not None or args.preswap_leads is not None or args.turn_weight is not None:
-        raise ValueError(
-            "--preswap_out, --preswap_leads and --turn_weight are for --task baoding (the Bounce script makes no swaps)"
-        )
-    stats = run_scripted_bounce(
-        robot=args.robot,
-        num_envs=args.num_envs,
-        seed=args.seed,
-        episodes=args.episodes,
-        progress=True,
-        backend=args.backend,
-        device=args.device,
-    )
-    print(json.dumps(stats))
-    return 0
-
-
-def _demo_baoding(args: argparse.Namespace) -> int:
-    import pathlib
-
-    from roto.reference.baoding_controller import PRESWAP_LEAD, run_reference_baoding
-    from roto.reference.baoding_cost import BaodingCostWeights
-
-    if args.preswap_leads is not None and args.preswap_out is None:
-        raise ValueError(f"--preswap_leads {args.preswap_leads} records states for --preswap_out; give that file too")
-    if args.backend != "cpu":
-        raise ValueError(f"backend {args.backend!r}: the Baoding reference controller plans on 'cpu' only")
-    if args.turn_weight is not None and not args.turn_weight >= 0:
-        raise ValueError(f"--turn_weight {args.turn_weight}: must be a weight >= 0 (0: off, no direction)")
-    out = pathlib.Path(args.preswap_out) if args.preswap_out else None
-    if out is not None and not out.parent.is_dir():
-        raise FileNotFoundError(f"--preswap_out: directory {str(out.parent)!r} does not exist")
-    stats = run_reference_baoding(
-        robot=args.robot,
-        episodes=args.episodes,
-        seed=args.seed,
-        threads=args.threads,
-        preswap_path=out,
-        preswap_leads=tuple(args.preswap_leads or (PRESWAP_LEAD,)),
-        progress=True,
-        weights=BaodingCostWeights(turn=args.turn_weight or 0.0),
-    )
-    print(json.dumps(stats))
     return 0
 
 
@@ -228,8 +155,8 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
     p_train = sub.add_parser(
         "train", help="train roto's PPO agent, optionally with auxiliary losses (progress bar, logs, checkpoints)"
     )
-    _add_env_args(p_train, num_envs=64)
-    _add_touch_arg(p_train)
+    add_env_args(p_train, num_envs=64)
+    add_touch_arg(p_train)
     p_train.add_argument(
         "--obs", "--obs_mode", "--obs-mode", dest="obs", default="blind", help="blind, state or proprio"
     )
@@ -302,7 +229,7 @@ def _add_render_parser(sub: argparse._SubParsersAction) -> None:
     p_render.add_argument("--task", default="bounce")
     p_render.add_argument("--robot", default="shadow")
     p_render.add_argument("--out", default="scene.png")
-    _add_touch_arg(p_render)
+    add_touch_arg(p_render)
     p_render.add_argument("--settle_steps", "--settle-steps", dest="settle_steps", type=int, default=60)
     p_render.add_argument("--seed", type=int, default=0)
     p_render.set_defaults(func=_cmd_render)
@@ -315,53 +242,12 @@ def _add_list_parser(sub: argparse._SubParsersAction) -> None:
 
 def _add_bench_parser(sub: argparse._SubParsersAction) -> None:
     p_bench = sub.add_parser("bench", help="env throughput vs plain physics stepping of the same model")
-    _add_env_args(p_bench, num_envs=256)
-    _add_touch_arg(p_bench)
+    add_env_args(p_bench, num_envs=256)
+    add_touch_arg(p_bench)
     p_bench.add_argument("--steps", type=int, default=200, help="timed control steps (default: 200)")
     p_bench.add_argument("--obs_mode", "--obs-mode", dest="obs_mode", default="blind")
     p_bench.add_argument("--json", action="store_true", help="print one JSON object")
     p_bench.set_defaults(func=_cmd_bench)
-
-
-def _add_demo_parser(sub: argparse._SubParsersAction) -> None:
-    p_demo = sub.add_parser(
-        "demo",
-        help="run a task's reference controller: the scripted Bounce policy (bounces per episode) or, with "
-        "--task baoding, predictive sampling over the true dynamics (rotations per episode; slow: about a "
-        "minute per episode on 2 threads)",
-    )
-    _add_env_args(p_demo, num_envs=8)
-    p_demo.add_argument(
-        "--episodes", type=int, default=1, help="episodes per env (Baoding: episodes of its one world; default: 1)"
-    )
-    p_demo.add_argument(
-        "--preswap_out",
-        "--preswap-out",
-        dest="preswap_out",
-        default=None,
-        help="Baoding: write the states recorded just before each swap to this .npz",
-    )
-    p_demo.add_argument(
-        "--preswap_leads",
-        "--preswap-leads",
-        dest="preswap_leads",
-        type=int,
-        nargs="+",
-        default=None,
-        help="Baoding: the control steps before each swap at which --preswap_out records a state (default: 10, "
-        "1/6 s; e.g. 10 20 30 40 50 60: the last second before each swap, back past the swap before it)",
-    )
-    p_demo.add_argument(
-        "--turn_weight",
-        "--turn-weight",
-        dest="turn_weight",
-        type=float,
-        default=None,
-        help="Baoding: weight of the turn the balls' axis still has to go counter-clockwise (seen from above) in "
-        "the planner's cost, so that it carries the balls round one way instead of swinging them (default: 0, "
-        "off: roto's swap rule has no direction)",
-    )
-    p_demo.set_defaults(func=_cmd_demo)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -379,7 +265,7 @@ def build_parser() -> argparse.ArgumentParser:
         _add_render_parser,
         _add_list_parser,
         _add_bench_parser,
-        _add_demo_parser,
+        add_demo_parser,
         add_sweep_parser,
         add_olympiad_parsers,
     ):

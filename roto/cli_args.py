@@ -1,0 +1,28 @@
+"""Flags that several ``roto`` commands share."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
+    """The env flags shared by the commands that build envs (task, robot, worlds, seed, backend)."""
+    parser.add_argument("--task", default="bounce", help="task name: bounce, baoding (default: bounce)")
+    parser.add_argument("--robot", default="shadow", help="robot name (default: shadow)")
+    parser.add_argument("--num_envs", "--num-envs", dest="num_envs", type=int, default=num_envs)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--threads", type=int, default=1, help="C threads stepping the worlds (CPU backend)")
+    parser.add_argument("--backend", default="cpu", help="physics backend: cpu (default) or warp (MuJoCo Warp)")
+    parser.add_argument("--device", default="cpu", help="cpu (default), or cuda[:k] with --backend warp")
+    parser.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; no effect")
+
+
+def add_touch_arg(parser: argparse.ArgumentParser) -> None:
+    """``--touch``: the tactile signal of the envs a command builds."""
+    parser.add_argument(
+        "--touch",
+        default="binary",
+        help="tactile signal: binary (a touch bit per link, the benchmark's; default), force "
+        "(log(1 + |F| / 0.1 N) of each link's net contact force) or taxels (the link bits, then a bit "
+        "per taxel of the fingertip pads and the palm)",
+    )
