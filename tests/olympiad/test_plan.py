@@ -312,7 +312,8 @@ def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_st
 
 
 def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
-    """Each cell is ORCA's packaged recipe with the round-swap aid, the round controller's bank, or both."""
+    """Each cell is ORCA's packaged recipe with the round-swap aid, the round controller's bank, both, or
+    that bank with nothing of the agent's own recorded into it."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
@@ -323,6 +324,7 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
         "round_swaps": {"env.swap_min_turn": (0.25, 0.0)},
         "round_bank": {"env.replay_starts": (round_bank, bank)},
         "round_bank_round_swaps": {"env.replay_starts": (round_bank, bank), "env.swap_min_turn": (0.25, 0.0)},
+        "round_bank_unrecorded": {"env.replay_starts": (round_bank, bank), "env.replay_record_lead": (0, 10)},
     }
     assert [c.variant for c in plan.cells] == list(expected)
     for cell in plan.cells:
