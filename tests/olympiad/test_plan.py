@@ -18,6 +18,7 @@ def test_packaged_plans():
         "bounce_long_shadow",
         "baoding_v1_low_noise",
         "baoding_v1_round",
+        "baoding_v1_orca_round",
     }
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
@@ -324,12 +325,18 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
         "round_swaps": {"env.swap_min_turn": (0.25, 0.0)},
         "round_bank": {"env.replay_starts": (round_bank, bank)},
         "round_bank_round_swaps": {"env.replay_starts": (round_bank, bank), "env.swap_min_turn": (0.25, 0.0)},
-        "round_bank_unrecorded": {"env.replay_starts": (round_bank, bank), "env.replay_record_lead": (0, 10)},
     }
-    assert [c.variant for c in plan.cells] == list(expected)
+    assert [(c.variant, c.seed) for c in plan.cells] == [
+        ("round_swaps", 0), ("round_bank", 0), ("round_bank_round_swaps", 0), ("round_bank_round_swaps", 1)]
     for cell in plan.cells:
-        assert cell_spec(plan, cell).differences(recipe) == expected[cell.variant]
+        seed = {"env.seed": (cell.seed, 0)} if cell.seed else {}
+        assert cell_spec(plan, cell).differences(recipe) == {**expected[cell.variant], **seed}
     assert pathlib.Path(round_bank).is_file()
+    long = load_plan("baoding_v1_orca_round")  # the round cells' continuation: the same runs, longer
+    assert long.steps == 20_000_000
+    assert [c.name for c in long.cells] == [c.name for c in plan.cells if c.variant == "round_bank_round_swaps"]
+    for cell in long.cells:  # training the same (the budget aside), so each 5 M run continues
+        assert cell_spec(long, cell).differences(cell_spec(plan, cell)) == {}
 
 
 def test_the_busiest_worker_and_a_running_cells_rate():
