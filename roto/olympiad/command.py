@@ -111,9 +111,9 @@ def headline_so_far(records: list[dict], metric: str, path_metrics: tuple[str, .
 
 def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1) -> str:
     """The cells and their status, and the time left at the throughput of the finished cells for
-    the env steps left (a started cell counts the env steps of its run's last evaluation); with
-    several workers, also the time until the busiest one is done, each at the running cells'
-    current throughput."""
+    the env steps left (a started cell counts the env steps of its run's last evaluation), or, with
+    none finished, at the started cells' latest throughput; with several workers, also the time
+    until the busiest one is done, each at the running cells' current throughput."""
     from roto.olympiad.results import read_summaries
     from roto.olympiad.worker import cell_status
     from roto.rl.evaluation import read_evaluations
@@ -122,13 +122,15 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
     status = cell_status(plan, root, results, storage)
     tasks = {cell.name: get_task(cell.task) for cell in plan.cells}
     lines = [f"plan {plan.name}: {len(plan.cells)} cells, {plan.steps} env steps each", ""]
-    done_steps, running_rates = {}, []
+    done_steps, running_rates, started_rates = {}, [], []
     for name, state in status.items():
         records = [] if state == "done" else read_evaluations(pathlib.Path(root) / plan.name / name)
         done_steps[name] = min(int(records[-1]["env_steps"]), plan.steps) if records else 0
-        rate_now = recent_rate(records) if state == "running" else None
+        rate_now = recent_rate(records)
         if rate_now:
-            running_rates.append(rate_now)
+            started_rates.append(rate_now)
+            if state == "running":
+                running_rates.append(rate_now)
         so_far = headline_so_far(records, tasks[name].headline_metric, tasks[name].path_metric_names)
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps{so_far})" if records else ""
         lines.append(f"  {name:<52} {state}{progress}")
@@ -142,6 +144,10 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
         rate = sum(s["env_steps"] for s in summaries) / sum(s["train_wall_s"] for s in summaries)
         hours = sum(cells_left) / rate / 3600
         estimate = f"{hours:.1f} h for one worker at {rate:.0f} env steps/s (the finished cells' throughput)"
+    elif started_rates:
+        rate = sum(started_rates) / len(started_rates)
+        hours = sum(cells_left) / rate / 3600
+        estimate = f"{hours:.1f} h for one worker at {rate:.0f} env steps/s (the started cells' last evaluation rounds)"
     else:
         rate = None
         estimate = f"unknown: no finished cell's summary in {results} (--results names the folder)"

@@ -110,6 +110,13 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     assert sorted(p.name for p in (tmp_path / "cpu").iterdir()) == [started.name]  # still no study
     assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
     assert f"time left: unknown: no finished cell's summary in {tmp_path / 'none'}" in capsys.readouterr().out
+    timed = [{**r, "train_wall_s": r["env_steps"] / 2500} for r in rounds]  # 2500 env steps/s between its rounds
+    (started / "evaluations.jsonl").write_text("".join(json.dumps(r) + "\n" for r in timed))
+    assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
+    # no finished cell: the started cell's throughput, (80 M - 2.5 M) / 2500 env steps/s = 31000 s
+    assert "time left: 8.6 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
+        capsys.readouterr().out
+    )
 
 
 def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():
@@ -327,7 +334,11 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
         "round_bank_round_swaps": {"env.replay_starts": (round_bank, bank), "env.swap_min_turn": (0.25, 0.0)},
     }
     assert [(c.variant, c.seed) for c in plan.cells] == [
-        ("round_swaps", 0), ("round_bank", 0), ("round_bank_round_swaps", 0), ("round_bank_round_swaps", 1)]
+        ("round_swaps", 0),
+        ("round_bank", 0),
+        ("round_bank_round_swaps", 0),
+        ("round_bank_round_swaps", 1),
+    ]
     for cell in plan.cells:
         seed = {"env.seed": (cell.seed, 0)} if cell.seed else {}
         assert cell_spec(plan, cell).differences(recipe) == {**expected[cell.variant], **seed}
