@@ -320,8 +320,8 @@ def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_st
 
 
 def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
-    """Each cell is ORCA's packaged recipe with the round-swap aid, the round controller's bank, both, or
-    that bank with nothing of the agent's own recorded into it."""
+    """Each cell is ORCA's packaged recipe with the round-swap aid, the round controller's bank, or both
+    (on two seeds); the 20 M plan continues the cells with both."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
