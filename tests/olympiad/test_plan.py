@@ -321,7 +321,7 @@ def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_st
 
 def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
     """Each cell is ORCA's packaged recipe with the round-swap aid, the round controller's bank, or both
-    (on two seeds); the 20 M plan continues the cells with both."""
+    (on two seeds); the 20 M plan continues the cells with both, which ``baoding_cpu_orca_round`` packages."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
@@ -348,6 +348,10 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
     assert [c.name for c in long.cells] == [c.name for c in plan.cells if c.variant == "round_bank_round_swaps"]
     for cell in long.cells:  # training the same (the budget aside), so each 5 M run continues
         assert cell_spec(long, cell).differences(cell_spec(plan, cell)) == {}
+    packaged = build_run_spec(
+        "baoding", "orca", "blind", "baoding_cpu_orca_round", [], plan.steps, num_envs=128, threads=1
+    )
+    assert packaged.differences(cell_spec(plan, Cell("baoding", "orca", "blind", "round_bank_round_swaps", 0))) == {}
 
 
 def test_the_busiest_worker_and_a_running_cells_rate():
