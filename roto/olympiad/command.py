@@ -140,21 +140,20 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
         summaries = read_summaries(results)
     except FileNotFoundError:
         summaries = []
+    rate, source = None, ""
     if summaries:
         rate = sum(s["env_steps"] for s in summaries) / sum(s["train_wall_s"] for s in summaries)
-        hours = sum(cells_left) / rate / 3600
-        estimate = f"{hours:.1f} h for one worker at {rate:.0f} env steps/s (the finished cells' throughput)"
+        source = "the finished cells' throughput"
     elif started_rates:
-        rate = sum(started_rates) / len(started_rates)
-        hours = sum(cells_left) / rate / 3600
-        estimate = f"{hours:.1f} h for one worker at {rate:.0f} env steps/s (the started cells' last evaluation rounds)"
+        rate, source = sum(started_rates) / len(started_rates), "the started cells' last evaluation rounds"
+    if rate:
+        estimate = f"{sum(cells_left) / rate / 3600:.1f} h for one worker at {rate:.0f} env steps/s ({source})"
     else:
-        rate = None
         estimate = f"unknown: no finished cell's summary in {results} (--results names the folder)"
     lines += ["", f"{len(status) - left} done, {left} left; time left: {estimate}"]
     if workers > 1 and (running_rates or rate):
         each = sum(running_rates) / len(running_rates) if running_rates else rate
-        source = "the running cells' last evaluation rounds" if running_rates else "the finished cells' throughput"
+        source = "the running cells' last evaluation rounds" if running_rates else source
         hours = busiest_worker_steps(cells_left, workers) / each / 3600
         lines.append(f"with {workers} workers at {each:.0f} env steps/s each ({source}): {hours:.1f} h")
     return "\n".join(lines)

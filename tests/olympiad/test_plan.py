@@ -117,6 +117,12 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     assert "time left: 8.6 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
         capsys.readouterr().out
     )
+    assert main(["olympiad", "cpu", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
+                 str(tmp_path / "none")]) == 0  # fmt: skip
+    # 15 cells of 5 M and one of 2.5 M over two workers: 40 M on the busier one = 16000 s
+    assert "with 2 workers at 2500 env steps/s each (the started cells' last evaluation rounds): 4.4 h" in (
+        capsys.readouterr().out
+    )
 
 
 def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():
