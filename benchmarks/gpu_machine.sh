@@ -10,10 +10,12 @@
 #                                               wheels staged so far into /tmp/site; unpack the kernel
 #                                               caches staged so far (kernels*.tar.xz.part-NN, from `pack`,
 #                                               or whole warp_cuda_*.tar.xz archives) into /tmp/wc
-#   bash benchmarks/gpu_machine.sh pack DIR     DIR (results of the sitting) into $OUT/results.tgz without full
-#                                               checkpoints or TensorBoard events, and the kernel cache into
-#                                               $OUT/kernels.tar.xz.part-NN of 15 MiB each (what a call brings
-#                                               back is limited to 16 MiB a file)
+#   bash benchmarks/gpu_machine.sh pack DIR     DIR (results of the sitting) into $OUT/results.tgz.part-NN without
+#                                               full checkpoints or TensorBoard events, and the kernel cache into
+#                                               $OUT/kernels.tar.xz.part-NN, each part at most 15 MiB (what a call
+#                                               brings back is limited to 16 MiB a file; two Baoding policies
+#                                               with their critics already make 17 MB)
+# Here, `cat results.tgz.part-* | tar -xzf -` unpacks the results.
 # Here, the parts that came back go into a folder of their own that git ignores (like the wheel
 # parts' .whl1 ...), which a later sitting carries and stages in one more call:
 #   mkdir -p .whl_kernels && cp kernels.tar.xz.part-* .whl_kernels/
@@ -42,7 +44,8 @@ install() {
 pack() {
   local dir=${1:?usage: gpu_machine.sh pack DIR}
   : "${OUT:?pack writes into \$OUT}"
-  tar -C "$(dirname "$dir")" --exclude='*tfevents*' --exclude='checkpoints' -czf "$OUT/results.tgz" "$(basename "$dir")"
+  tar -C "$(dirname "$dir")" --exclude='*tfevents*' --exclude='checkpoints' -czf - "$(basename "$dir")" \
+    | split -b 15M -d -a 2 - "$OUT/results.tgz.part-"
   if [ -d "$cache_parent/wc" ]; then
     tar -C "$cache_parent" -cf - wc | xz -T0 -6 | split -b 15M -d -a 2 - "$OUT/kernels.tar.xz.part-"
   fi

@@ -1,6 +1,6 @@
 """Plot a training run's evaluation curve against env steps and wall time (for docs/results.md).
 
-    python benchmarks/learning_curve.py RUN_DIR OUT.png [--metric bounces] [--title TEXT]
+    python benchmarks/learning_curve.py RUN_DIR OUT.png [--metric bounces] [--title TEXT] [--window 10]
 
 Wall time is ``perf/train_wall_s`` when the run logged it, else the sum of each update's
 duration (env steps per update / ``perf/steps_per_s``).
@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt
 
 from roto.rl.run_dir import read_scalars
 
-WINDOW = 10  # evaluation rounds in the running mean
+WINDOW = 10  # evaluation rounds in the running mean, unless --window says otherwise
 THRESHOLDS = (5, 10, 18, 25)  # running-mean levels whose first crossing the summary reports
 
 
@@ -34,6 +34,11 @@ def wall_time_at(series: dict[str, tuple[list[int], list[float]]]) -> dict[int, 
             total += per_update / rate
             wall.append(total)
     return dict(zip(wall_steps, wall, strict=True))
+
+
+def wall_label(seconds: float, longest: float) -> str:
+    """A wall-time tick: minutes, or seconds for a run shorter than 10 minutes."""
+    return f"{seconds:.0f} s" if longest < 600 else f"{seconds / 60:.0f} min"
 
 
 def running_mean(values: list[float], window: int) -> list[float]:
@@ -57,7 +62,7 @@ def draw(
         lw=0.8,
         label=f"each evaluation round ({args.metric}, mean of its episodes)",
     )
-    ax.plot(steps, smooth, color="tab:blue", lw=2, label=f"running mean of {WINDOW} rounds")
+    ax.plot(steps, smooth, color="tab:blue", lw=2, label=f"running mean of {args.window} rounds")
     ax.set_xlabel("env steps")
     ax.set_ylabel(f"{args.metric} per 10 s episode")
     ax.grid(alpha=0.3)
@@ -65,7 +70,7 @@ def draw(
     top = ax.secondary_xaxis("top", functions=(lambda x: x, lambda x: x))
     ticks = ax.get_xticks()
     wall_ticks = [min(wall_at, key=lambda s, t=t: abs(s - t)) for t in ticks if 0 <= t <= max(steps)]
-    top.set_xticks(wall_ticks, labels=[f"{wall_at[s] / 60:.0f} min" for s in wall_ticks])
+    top.set_xticks(wall_ticks, labels=[wall_label(wall_at[s], max(wall_at.values())) for s in wall_ticks])
     top.set_xlabel("training wall time (rollouts + updates)")
     if args.title:
         ax.set_title(args.title, fontsize=10, pad=30)
@@ -100,11 +105,12 @@ def main() -> None:
     parser.add_argument("out")
     parser.add_argument("--metric", default="bounces")
     parser.add_argument("--title", default=None)
+    parser.add_argument("--window", type=int, default=WINDOW, help="evaluation rounds in the running mean")
     args = parser.parse_args()
     series = read_scalars(args.run_dir)
     steps, mean = series[f"eval/{args.metric}_mean"]
     wall_at = wall_time_at(series)
-    smooth = running_mean(mean, WINDOW)
+    smooth = running_mean(mean, args.window)
     draw(args, steps, mean, smooth, wall_at)
     print(json.dumps(summarize(steps, mean, smooth, wall_at)))
 
