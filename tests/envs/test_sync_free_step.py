@@ -2,19 +2,35 @@
 against the CPU step it replaces, on the CPU where both can run; and, on a GPU, that the step never
 waits for the device."""
 
+import pathlib
+
 import pytest
 import torch
 
 import roto
 from roto.registry import list_envs
 
+BANK = str(pathlib.Path(__file__).resolve().parents[2] / "benchmarks/results/baoding_reference/shadow_preswap.npz")
+BAODING_AIDS = {
+    "replay_starts": BANK,
+    "replay_share": 0.5,
+    "replay_record_lead": 10,
+    "tolerance_start": 0.025,
+    "tolerance_target": 2.0,
+    "swap_min_turn": 0.25,
+    "extra_groups": ("privileged", "task"),
+}
+"""Every training aid of the Baoding recipes at once (baoding_cpu_shadow, baoding_cpu_orca_round) and
+the groups their critic reads: what a GPU training env of those recipes steps."""
 
-def rollout(env, steps: int, seed: int = 0) -> tuple[list[torch.Tensor], int]:
-    """Everything the env hands out over ``steps`` random-action steps, and how many episodes ended."""
+
+def rollout(env, steps: int, seed: int = 0, after_step=None) -> tuple[list[torch.Tensor], int]:
+    """Everything the env hands out over ``steps`` random-action steps, and how many episodes ended;
+    ``after_step(t)``, if given, runs after step t (0-based)."""
     generator = torch.Generator(device=env.device).manual_seed(seed)
     obs, _ = env.reset(seed=seed)
     seen, finished = [torch.cat([v.flatten() for v in obs.values()])], 0
-    for _ in range(steps):
+    for t in range(steps):
         action = torch.rand(env.num_envs, env.num_actions, generator=generator, device=env.device) * 2 - 1
         obs, reward, terminated, truncated, info = env.step(action)
         done = terminated | truncated
@@ -23,6 +39,8 @@ def rollout(env, steps: int, seed: int = 0) -> tuple[list[torch.Tensor], int]:
         if "episode" in info and bool(info["_episode"].any()):  # a sync-free step always has the keys
             mask = info["_episode"]
             seen += [info["episode"]["r"][mask], info["final_obs"]["proprio"][mask].flatten()]
+        if after_step is not None:
+            after_step(t)
     return seen, finished
 
 
@@ -38,6 +56,26 @@ def test_sync_free_step_is_bit_identical_to_the_cpu_step(task, robot):
     (a, finished), (b, _) = rollout(reference, 150), rollout(candidate, 150)
     assert finished > 5, "too few episodes ended: the masked reset went untested"
     assert len(a) == len(b) and all(torch.equal(x, y) for x, y in zip(a, b, strict=True))
+
+
+def test_sync_free_step_with_the_baoding_training_aids_is_bit_identical_to_the_cpu_step():
+    # a replayed start drawn from the states the env records depends on when it is drawn: the CPU
+    # step draws when a reset runs short, the sync-free step tops its pool up every check_every
+    # steps, so here the CPU step's pool is topped up on the same steps (and from the same reset)
+    reference = roto.make("baoding", robot="shadow", num_envs=6, seed=1, **BAODING_AIDS)
+    reference.check_every = 3  # on the CPU step this sizes only the pool reset() fills
+
+    def top_up(t: int) -> None:
+        if (t + 1) % 3 == 0:
+            reference._starts.ensure(3 * reference.num_envs)
+
+    candidate = sync_free(roto.make("baoding", robot="shadow", num_envs=6, seed=1, **BAODING_AIDS), check_every=3)
+    (a, finished), (b, _) = rollout(reference, 150, after_step=top_up), rollout(candidate, 150)
+    assert finished > 5, "too few episodes ended: the masked reset went untested"
+    assert len(a) == len(b) and all(torch.equal(x, y) for x, y in zip(a, b, strict=True))
+    assert int(reference.recorder.recorded) > 0, "no state was recorded: the recorded bank went untested"
+    assert torch.equal(reference.recorder.recorded, candidate.recorder.recorded)
+    assert torch.equal(reference.curriculum.mean, candidate.curriculum.mean)
 
 
 def test_sync_free_step_reports_a_non_finite_action_at_the_next_check():
@@ -70,9 +108,13 @@ cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="needs an NVIDIA
 
 @pytest.mark.gpu
 @cuda
-@pytest.mark.parametrize(("task", "robot"), [(t, r) for t, r in list_envs()])
-def test_gpu_step_never_waits_for_the_device(task, robot):
-    env = roto.make(task, robot=robot, num_envs=1024, backend="warp", device="cuda", seed=0)
+@pytest.mark.parametrize(
+    ("task", "robot", "aids"),
+    [(t, r, {}) for t, r in list_envs()] + [("baoding", "shadow", BAODING_AIDS)],
+    ids=[f"{t}-{r}" for t, r in list_envs()] + ["baoding-shadow-training_aids"],
+)
+def test_gpu_step_never_waits_for_the_device(task, robot, aids):
+    env = roto.make(task, robot=robot, num_envs=1024, backend="warp", device="cuda", seed=0, **aids)
     env.reset(seed=0)
     generator = torch.Generator(device="cuda").manual_seed(0)
     finished = torch.zeros((), dtype=torch.int64, device="cuda")
