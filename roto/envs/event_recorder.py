@@ -77,13 +77,13 @@ class EventRecorder:
         restarts at 0)."""
         metric = metric.to(torch.float64)
         event = (metric > self.last_metric) & (length > self.lead)
-        slot = self.steps % self.lead
+        slot = (self.steps % self.lead).view(1)  # (1,) on the device: indexing by a 0-d tensor reads it back
         capacity = self.capacity
         position = (self.recorded + torch.cumsum(event.to(torch.int64), 0) - 1) % capacity
         position = torch.where(event, position, capacity)  # the spare row takes the worlds without one
         for name, ring in self.ring.items():
-            self.bank[name][position] = ring[slot]
-            ring[slot] = rows[name]
+            self.bank[name][position] = ring.index_select(0, slot)[0]
+            ring.index_copy_(0, slot, rows[name].to(ring.dtype).unsqueeze(0))
         self.recorded += event.sum()
         self.steps += 1
         self.last_metric = metric.masked_fill(done, 0.0)

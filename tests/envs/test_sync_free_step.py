@@ -2,13 +2,19 @@
 against the CPU step it replaces, on the CPU where both can run; and, on a GPU, that the step never
 waits for the device."""
 
+import contextlib
 import pathlib
 
 import pytest
 import torch
+from torch.utils._python_dispatch import TorchDispatchMode
 
 import roto
+import roto.envs.roto_env
+import roto.sim.mujoco_warp
+import roto.tasks.baoding
 from roto.registry import list_envs
+from tests.conftest import require_warp
 
 BANK = str(pathlib.Path(__file__).resolve().parents[2] / "benchmarks/results/baoding_reference/shadow_preswap.npz")
 BAODING_AIDS = {
@@ -101,6 +107,57 @@ def test_sync_free_state_dict_resumes_exactly():
     for _ in range(60):
         a, b = whole.step(action), resumed.step(action)
         assert all(torch.equal(a[0][k], b[0][k]) for k in a[0]) and torch.equal(a[1], b[1])
+
+
+HOST_READS = ("aten._local_scalar_dense", "aten.nonzero", "aten.masked_select", "aten.unique", "aten._unique2")
+"""Ops that read a tensor's values back to the host (``.item()``, ``bool()``, indexing by a 0-d tensor,
+boolean masks, data-dependent shapes): on a GPU each waits for the device."""
+
+
+class HostReads(TorchDispatchMode):
+    """Records every ``HOST_READS`` op run while it is active and not paused."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.seen: list[str] = []
+        self.paused = False
+
+    def __torch_dispatch__(self, func, types, args=(), kwargs=None):
+        if not self.paused and str(func).startswith(HOST_READS):
+            self.seen.append(str(func))
+        return func(*args, **(kwargs or {}))
+
+
+@pytest.mark.parametrize(
+    ("task", "robot", "aids"), [("bounce", "shadow", {}), ("baoding", "shadow", BAODING_AIDS)], ids=["bounce", "aids"]
+)
+def test_sync_free_warp_step_reads_nothing_back_outside_its_periodic_checks(task, robot, aids, monkeypatch):
+    # what a GPU env runs, on Warp's CPU device: every host read must be a deliberate one
+    require_warp()
+    env = sync_free(roto.make(task, robot=robot, num_envs=4, backend="warp", device="cpu", seed=0, **aids), 5)
+    env.reset(seed=0)
+    reads = HostReads()
+
+    @contextlib.contextmanager
+    def deliberate(device):
+        reads.paused = True
+        try:
+            yield
+        finally:
+            reads.paused = False
+
+    monkeypatch.setattr(roto.envs.roto_env, "deliberate_host_sync", deliberate)
+    monkeypatch.setattr(roto.sim.mujoco_warp, "deliberate_host_sync", deliberate)
+    monkeypatch.setattr(roto.tasks.baoding, "zero_on_host", lambda x: False)  # its answer for a GPU tensor
+    generator = torch.Generator().manual_seed(0)
+    ended = torch.zeros((), dtype=torch.int64)
+    with reads:
+        for _ in range(40):
+            _, _, terminated, truncated, _ = env.step(torch.rand(4, env.num_actions, generator=generator) * 2 - 1)
+            ended += (terminated | truncated).sum()
+    assert reads.seen == [], f"host reads outside the periodic checks: {sorted(set(reads.seen))}"
+    assert int(ended) > 0, "no episode ended: the masked reset went untested"
+    env.close()
 
 
 cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="needs an NVIDIA GPU")
