@@ -1,10 +1,72 @@
+import contextlib
 import importlib.util
 import os
+import pathlib
 
 import pytest
 import torch
+from torch.utils._python_dispatch import TorchDispatchMode
 
 import roto
+
+SHADOW_BANK = str(
+    pathlib.Path(__file__).resolve().parents[1] / "benchmarks/results/baoding_reference/shadow_preswap.npz"
+)
+"""The Shadow reference controller's pre-swap states (a packaged recipe's replay bank)."""
+
+BAODING_AIDS = {
+    "replay_starts": SHADOW_BANK,
+    "replay_share": 0.5,
+    "replay_record_lead": 10,
+    "tolerance_start": 0.025,
+    "tolerance_target": 2.0,
+    "swap_min_turn": 0.25,
+}
+"""Every training aid of the Baoding recipes at once (baoding_cpu_shadow, baoding_cpu_orca_round)."""
+
+HOST_READS = ("aten._local_scalar_dense", "aten.nonzero", "aten.masked_select", "aten.unique", "aten._unique2")
+"""Ops that read a tensor's values back to the host (``.item()``, ``bool()``, indexing by a 0-d tensor,
+boolean masks, data-dependent shapes): on a GPU each waits for the device."""
+
+
+class HostReads(TorchDispatchMode):
+    """Records every ``HOST_READS`` op run while it is active and not paused."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.seen: list[str] = []
+        self.paused = False
+
+    def __torch_dispatch__(self, func, types, args=(), kwargs=None):
+        if not self.paused and str(func).startswith(HOST_READS):
+            self.seen.append(str(func))
+        return func(*args, **(kwargs or {}))
+
+
+@pytest.fixture
+def host_reads(monkeypatch) -> HostReads:
+    """A ``HostReads`` mode (enter it around the code under test) that pauses inside roto's deliberate
+    host reads, with the CPU-only shortcut ``zero_on_host`` answering as for a GPU tensor: on Warp's
+    CPU device it then sees what a GPU run would wait for."""
+    import roto.envs.roto_env
+    import roto.rl.runner
+    import roto.sim.mujoco_warp
+    import roto.tasks.baoding
+
+    reads = HostReads()
+
+    @contextlib.contextmanager
+    def deliberate(device):
+        reads.paused = True
+        try:
+            yield
+        finally:
+            reads.paused = False
+
+    for module in (roto.envs.roto_env, roto.sim.mujoco_warp, roto.rl.runner):
+        monkeypatch.setattr(module, "deliberate_host_sync", deliberate)
+    monkeypatch.setattr(roto.tasks.baoding, "zero_on_host", lambda x: False)
+    return reads
 
 
 @pytest.fixture(autouse=True)

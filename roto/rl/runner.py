@@ -32,6 +32,7 @@ from roto.rl.settings import TrainSettings, read_run_config, run_config, write_r
 from roto.rl.stop_requests import StopRequests
 from roto.rl.torch_threads import single_torch_thread
 from roto.rl.wandb_run import logged_wandb_project, open_wandb_run, require_wandb
+from roto.sim.host_sync import deliberate_host_sync
 
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded with seed + this, so they never replay the training envs' resets."""
@@ -222,7 +223,8 @@ class Trainer:
             t_sim += t2 - t1
         scalars = {"perf/inference_s": t_inference, "perf/simulation_s": t_sim}
         if getattr(self.env, "curriculum", None) is not None:  # a training aid's state, read once per update
-            scalars["train/success_radius"] = float(self.env.curriculum.radius())
+            with deliberate_host_sync(self.device):
+                scalars["train/success_radius"] = float(self.env.curriculum.radius())
         return scalars
 
     def _evaluate(self) -> dict[str, float]:

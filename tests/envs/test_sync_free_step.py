@@ -2,32 +2,16 @@
 against the CPU step it replaces, on the CPU where both can run; and, on a GPU, that the step never
 waits for the device."""
 
-import contextlib
-import pathlib
-
 import pytest
 import torch
-from torch.utils._python_dispatch import TorchDispatchMode
 
 import roto
-import roto.envs.roto_env
-import roto.sim.mujoco_warp
-import roto.tasks.baoding
 from roto.registry import list_envs
-from tests.conftest import require_warp
+from tests.conftest import BAODING_AIDS, require_warp
 
-BANK = str(pathlib.Path(__file__).resolve().parents[2] / "benchmarks/results/baoding_reference/shadow_preswap.npz")
-BAODING_AIDS = {
-    "replay_starts": BANK,
-    "replay_share": 0.5,
-    "replay_record_lead": 10,
-    "tolerance_start": 0.025,
-    "tolerance_target": 2.0,
-    "swap_min_turn": 0.25,
-    "extra_groups": ("privileged", "task"),
-}
-"""Every training aid of the Baoding recipes at once (baoding_cpu_shadow, baoding_cpu_orca_round) and
-the groups their critic reads: what a GPU training env of those recipes steps."""
+RECIPE = {**BAODING_AIDS, "extra_groups": ("privileged", "task")}
+"""The Baoding recipes' training aids and the groups their critic reads: what a GPU training env of
+those recipes steps."""
 
 
 def rollout(env, steps: int, seed: int = 0, after_step=None) -> tuple[list[torch.Tensor], int]:
@@ -68,14 +52,14 @@ def test_sync_free_step_with_the_baoding_training_aids_is_bit_identical_to_the_c
     # a replayed start drawn from the states the env records depends on when it is drawn: the CPU
     # step draws when a reset runs short, the sync-free step tops its pool up every check_every
     # steps, so here the CPU step's pool is topped up on the same steps (and from the same reset)
-    reference = roto.make("baoding", robot="shadow", num_envs=6, seed=1, **BAODING_AIDS)
+    reference = roto.make("baoding", robot="shadow", num_envs=6, seed=1, **RECIPE)
     reference.check_every = 3  # on the CPU step this sizes only the pool reset() fills
 
     def top_up(t: int) -> None:
         if (t + 1) % 3 == 0:
             reference._starts.ensure(3 * reference.num_envs)
 
-    candidate = sync_free(roto.make("baoding", robot="shadow", num_envs=6, seed=1, **BAODING_AIDS), check_every=3)
+    candidate = sync_free(roto.make("baoding", robot="shadow", num_envs=6, seed=1, **RECIPE), check_every=3)
     (a, finished), (b, _) = rollout(reference, 150, after_step=top_up), rollout(candidate, 150)
     assert finished > 5, "too few episodes ended: the masked reset went untested"
     assert len(a) == len(b) and all(torch.equal(x, y) for x, y in zip(a, b, strict=True))
@@ -109,53 +93,21 @@ def test_sync_free_state_dict_resumes_exactly():
         assert all(torch.equal(a[0][k], b[0][k]) for k in a[0]) and torch.equal(a[1], b[1])
 
 
-HOST_READS = ("aten._local_scalar_dense", "aten.nonzero", "aten.masked_select", "aten.unique", "aten._unique2")
-"""Ops that read a tensor's values back to the host (``.item()``, ``bool()``, indexing by a 0-d tensor,
-boolean masks, data-dependent shapes): on a GPU each waits for the device."""
-
-
-class HostReads(TorchDispatchMode):
-    """Records every ``HOST_READS`` op run while it is active and not paused."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.seen: list[str] = []
-        self.paused = False
-
-    def __torch_dispatch__(self, func, types, args=(), kwargs=None):
-        if not self.paused and str(func).startswith(HOST_READS):
-            self.seen.append(str(func))
-        return func(*args, **(kwargs or {}))
-
-
 @pytest.mark.parametrize(
-    ("task", "robot", "aids"), [("bounce", "shadow", {}), ("baoding", "shadow", BAODING_AIDS)], ids=["bounce", "aids"]
+    ("task", "robot", "aids"), [("bounce", "shadow", {}), ("baoding", "shadow", RECIPE)], ids=["bounce", "aids"]
 )
-def test_sync_free_warp_step_reads_nothing_back_outside_its_periodic_checks(task, robot, aids, monkeypatch):
+def test_sync_free_warp_step_reads_nothing_back_outside_its_periodic_checks(task, robot, aids, host_reads):
     # what a GPU env runs, on Warp's CPU device: every host read must be a deliberate one
     require_warp()
     env = sync_free(roto.make(task, robot=robot, num_envs=4, backend="warp", device="cpu", seed=0, **aids), 5)
     env.reset(seed=0)
-    reads = HostReads()
-
-    @contextlib.contextmanager
-    def deliberate(device):
-        reads.paused = True
-        try:
-            yield
-        finally:
-            reads.paused = False
-
-    monkeypatch.setattr(roto.envs.roto_env, "deliberate_host_sync", deliberate)
-    monkeypatch.setattr(roto.sim.mujoco_warp, "deliberate_host_sync", deliberate)
-    monkeypatch.setattr(roto.tasks.baoding, "zero_on_host", lambda x: False)  # its answer for a GPU tensor
     generator = torch.Generator().manual_seed(0)
     ended = torch.zeros((), dtype=torch.int64)
-    with reads:
+    with host_reads:
         for _ in range(40):
             _, _, terminated, truncated, _ = env.step(torch.rand(4, env.num_actions, generator=generator) * 2 - 1)
             ended += (terminated | truncated).sum()
-    assert reads.seen == [], f"host reads outside the periodic checks: {sorted(set(reads.seen))}"
+    assert host_reads.seen == [], f"host reads outside the periodic checks: {sorted(set(host_reads.seen))}"
     assert int(ended) > 0, "no episode ended: the masked reset went untested"
     env.close()
 
@@ -167,7 +119,7 @@ cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="needs an NVIDIA
 @cuda
 @pytest.mark.parametrize(
     ("task", "robot", "aids"),
-    [(t, r, {}) for t, r in list_envs()] + [("baoding", "shadow", BAODING_AIDS)],
+    [(t, r, {}) for t, r in list_envs()] + [("baoding", "shadow", RECIPE)],
     ids=[f"{t}-{r}" for t, r in list_envs()] + ["baoding-shadow-training_aids"],
 )
 def test_gpu_step_never_waits_for_the_device(task, robot, aids):

@@ -1,0 +1,44 @@
+"""The training rollout loop as a GPU runs it (the sync-free env step, the policy, the buffer, the
+episode statistics), on Warp's CPU device: it reads nothing back from the device outside the
+deliberate reads (the env's periodic checks, a training aid's state once per update). On a GPU,
+tests/rl/test_training_gpu.py checks the same under CUDA's sync-debug mode."""
+
+import torch
+
+from roto.envs.config import EnvConfig
+from roto.rl.config import load_agent_config
+from roto.rl.runner import Trainer, TrainSettings
+from tests.conftest import BAODING_AIDS, require_warp
+
+
+def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch, host_reads):
+    require_warp()
+    env = EnvConfig(
+        task="baoding",
+        robot="shadow",
+        num_envs=4,
+        backend="warp",
+        device="cpu",
+        seed=0,
+        episode_steps=60,
+        **BAODING_AIDS,
+    )
+    agent = load_agent_config(
+        "baoding_cpu_shadow", overrides=["ppo.rollouts=8", "run.eval_every=100", "run.num_eval_envs=2"]
+    )
+    settings = TrainSettings(env=env, total_steps=3 * agent.ppo.rollouts * env.num_envs)
+    trainer = Trainer(settings, agent, tmp_path / "run", tensorboard=False)
+    trainer.env.sync_free_step, trainer.env.check_every = True, 4  # as on a GPU
+    assert trainer.env.recorder is not None and trainer.env.curriculum is not None
+    collect, collected = trainer._collect_rollout, []
+
+    def collect_watched():
+        with host_reads:
+            collected.append(collect())
+        return collected[-1]
+
+    monkeypatch.setattr(trainer, "_collect_rollout", collect_watched)
+    trainer.train(progress=False)
+    assert len(collected) == 3 and "train/success_radius" in collected[-1]
+    assert host_reads.seen == [], f"host reads in the rollouts: {sorted(set(host_reads.seen))}"
+    assert all(torch.isfinite(p).all() for p in trainer.model.parameters())
