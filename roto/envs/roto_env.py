@@ -134,6 +134,9 @@ class RotoEnv:
         self._starts.ensure(self.check_every * self.num_envs)
         self._since_check = 0
         frame = self._reset_where(torch.ones(self.num_envs, dtype=torch.bool, device=self.device))
+        if self.sync_free_step:  # read only every check_every steps: cover every world ending on each of them
+            with deliberate_host_sync(self.device):
+                self._starts.ensure(self.check_every * self.num_envs)
         self._stack.reset(frame)
         if self.recorder is not None:  # every episode starts over: no metric to rise from
             self.recorder.last_metric.zero_()

@@ -16,9 +16,11 @@ those recipes steps."""
 
 def rollout(env, steps: int, seed: int = 0, after_step=None) -> tuple[list[torch.Tensor], int]:
     """Everything the env hands out over ``steps`` random-action steps, and how many episodes ended;
-    ``after_step(t)``, if given, runs after step t (0-based)."""
+    ``after_step(t)``, if given, runs after the reset (t = -1) and after each step t (0-based)."""
     generator = torch.Generator(device=env.device).manual_seed(seed)
     obs, _ = env.reset(seed=seed)
+    if after_step is not None:
+        after_step(-1)
     seen, finished = [torch.cat([v.flatten() for v in obs.values()])], 0
     for t in range(steps):
         action = torch.rand(env.num_envs, env.num_actions, generator=generator, device=env.device) * 2 - 1
@@ -48,15 +50,32 @@ def test_sync_free_step_is_bit_identical_to_the_cpu_step(task, robot):
     assert len(a) == len(b) and all(torch.equal(x, y) for x, y in zip(a, b, strict=True))
 
 
+def test_sync_free_step_has_a_start_for_every_world_ending_on_every_step():
+    # its pool is read only every check_every steps: from a reset on it must cover every world
+    # ending on each of them (a pool run dry hands its last row out again, then raises)
+    env = sync_free(roto.make("bounce", num_envs=3, seed=0), check_every=3)
+    env.reset(seed=0)
+    starts = []
+    for _ in range(7):
+        qpos = torch.from_numpy(env.backend.qpos.copy())
+        qpos[:, env._idx.ball_pos.index[0, 2]] = -0.5  # every ball far below the palm: every world ends
+        env.backend.set_state(torch.arange(3), qpos, torch.zeros(3, env.model.nv))
+        _, _, terminated, _, _ = env.step(torch.zeros(3, env.num_actions))
+        assert terminated.all()
+        starts.append(torch.from_numpy(env.backend.qpos.copy()))
+    every = torch.cat(starts)
+    assert len(torch.unique(every, dim=0)) == len(every), "a start was handed out twice"
+
+
 def test_sync_free_step_with_the_baoding_training_aids_is_bit_identical_to_the_cpu_step():
     # a replayed start drawn from the states the env records depends on when it is drawn: the CPU
-    # step draws when a reset runs short, the sync-free step tops its pool up every check_every
-    # steps, so here the CPU step's pool is topped up on the same steps (and from the same reset)
+    # step draws when a reset runs short, the sync-free step tops its pool up after its reset and
+    # every check_every steps, so here the CPU step's pool is topped up then too
     reference = roto.make("baoding", robot="shadow", num_envs=6, seed=1, **RECIPE)
     reference.check_every = 3  # on the CPU step this sizes only the pool reset() fills
 
     def top_up(t: int) -> None:
-        if (t + 1) % 3 == 0:
+        if t == -1 or (t + 1) % 3 == 0:
             reference._starts.ensure(3 * reference.num_envs)
 
     candidate = sync_free(roto.make("baoding", robot="shadow", num_envs=6, seed=1, **RECIPE), check_every=3)
