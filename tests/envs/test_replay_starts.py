@@ -1,8 +1,6 @@
 """Replayed starts: a share of training episodes starts from recorded pre-swap states, exactly as
 recorded, resumably; share 0 changes nothing and evaluation never replays."""
 
-import pathlib
-
 import numpy as np
 import pytest
 import torch
@@ -10,8 +8,9 @@ import torch
 import roto
 from roto.envs.config import EnvConfig
 from roto.rl.settings import TrainSettings
+from tests.conftest import SHADOW_BANK
 
-BANK = str(pathlib.Path(__file__).resolve().parents[2] / "benchmarks/results/baoding_reference/shadow_preswap.npz")
+BANK = SHADOW_BANK  # the Shadow reference controller's pre-swap states
 
 
 def replay_env(share: float, num_envs: int = 4, seed: int = 0, **kwargs):
