@@ -131,7 +131,8 @@ class RotoEnv:
         if seed is not None:
             self._generator.manual_seed(int(seed))
         self._starts.clear()  # a reset, seeded or not, starts from freshly drawn starts
-        self._starts.ensure(self.check_every * self.num_envs)
+        with deliberate_host_sync(self.device):  # a reset draws starts, reading the pool as it goes
+            self._starts.ensure(self.check_every * self.num_envs)
         self._since_check = 0
         frame = self._reset_where(torch.ones(self.num_envs, dtype=torch.bool, device=self.device))
         if self.sync_free_step:  # read only every check_every steps: cover every world ending on each of them
