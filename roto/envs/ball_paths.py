@@ -50,17 +50,25 @@ class BallPathRecorder:
         self.positions.append(ball_positions(obs[BALL_GROUP], self.n_ball).clone())
         return self.act(obs)
 
-    def path_metrics(self, task: Task, lengths: torch.Tensor) -> dict[str, list[float]]:
+    def path_metrics(
+        self, task: Task, lengths: torch.Tensor, metrics: dict[str, torch.Tensor]
+    ) -> dict[str, list[float]]:
         """Each env's first episode's ``task.path_metrics``, from its first ``lengths[i]`` observations.
 
         Args:
             lengths: (B,) steps of each env's first episode; observation 0 is the one after its reset.
+            metrics: {name: B values (a list or a (B,) array)} each of the task's ``metric_names`` at
+                that episode's end.
 
         Returns:
             {name: B values}, in env order.
         """
         path = torch.stack(self.positions).cpu()  # (steps, B, n_ball, 3)
-        rows = [task.path_metrics(path[: int(length), i]) for i, length in enumerate(lengths.tolist())]
+        ends = {name: torch.as_tensor(values).tolist() for name, values in metrics.items()}
+        rows = [
+            task.path_metrics(path[: int(length), i], {name: values[i] for name, values in ends.items()})
+            for i, length in enumerate(lengths.tolist())
+        ]
         return {name: [row[name] for row in rows] for name in task.path_metric_names}
 
 
@@ -75,5 +83,6 @@ def first_episodes_with_paths(
     result = first_episodes(env, recorder or act, obs)
     per_episode = {name: values[:, 0].tolist() for name, values in result.items()}
     if recorder is not None:
-        per_episode.update(recorder.path_metrics(env.task, result["length"][:, 0]))
+        ends = {name: per_episode[name] for name in env.task.metric_names}
+        per_episode.update(recorder.path_metrics(env.task, result["length"][:, 0], ends))
     return per_episode

@@ -115,7 +115,8 @@ def run_reference_episode(
             preswap.record(history, leads)
         if bool(terminated[0] | truncated[0]):
             episode = info["episode"]
-            paths = act.path_metrics(env.task, episode["l"])  # the episode's own observations
+            ends = {name: episode[name] for name in env.task.metric_names}
+            paths = act.path_metrics(env.task, episode["l"], ends)  # the episode's own observations
             return {
                 "swaps": float(episode["swaps"][0]),
                 "rotations": float(episode["rotations"][0]),

@@ -29,9 +29,11 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--space", default="roto2", help="search space: a name in roto/configs/sweep/ (default roto2) or a YAML file"
     )
-    p.add_argument("--objective", default="return", choices=("return", "metric"),
-                   help="what trials maximise: the best evaluation's mean return (default), or the task's "
-                        "headline metric (Baoding: rotations) with the return breaking ties")  # fmt: skip
+    p.add_argument("--objective", default="return",
+                   help="what trials maximise: the best evaluation's mean return (default), 'metric' (the task's "
+                        "headline metric, Baoding: rotations), or another metric the task's evaluations report "
+                        "(Baoding: round_rotations, the rotations its pair's net turning backs), with the return "
+                        "breaking ties")  # fmt: skip
     p.add_argument("--trials", type=int, default=40, help="trials that finish (complete or pruned)")
     p.add_argument("--startup", type=int, default=8, help="random start-up trials (also the pruner's wait)")
     p.add_argument("--steps", type=int, default=2_500_000, help="env steps per trial")

@@ -149,6 +149,7 @@ def _short(value: object) -> str:
 
 def _objective_name(settings: dict) -> str:
     """What a study's trial values are (its stored objective; studies stored before it: the return)."""
-    if settings.get("objective", "return") == "return":
+    objective = settings.get("objective", "return")
+    if objective == "return":
         return "return"
-    return f"headline metric (+{TIE_BREAK:g} x return)"
+    return f"{'headline metric' if objective == 'metric' else objective} (+{TIE_BREAK:g} x return)"

@@ -13,6 +13,7 @@ import optuna
 from roto.envs.config import EnvConfig
 from roto.sweep.pruner import MedianBestSoFarPruner
 from roto.sweep.storage import JOURNAL_NAME, find_study, open_storage, redact_url
+from roto.tasks import get_task
 
 STUDY_NAME = re.compile(r"[A-Za-z0-9._-]+")
 """A study name: one folder name under ``--root``, nothing that climbs out of it."""
@@ -21,8 +22,9 @@ SEEDS = (0, 1, 2, 3, 4)
 """Each trial trains with one of these seeds, drawn per trial (docs/spec.md §8)."""
 SETTINGS_ATTR = "roto:settings"
 OBJECTIVES = ("return", "metric")
-"""What trials maximise: the best evaluation's mean return, or the task's headline metric with the
-return breaking ties (``roto.sweep.trial.objective_value``)."""
+"""What trials maximise, on any task: the best evaluation's mean return, or the task's headline
+metric with the return breaking ties; a task's other evaluation metrics may be named too
+(``objectives_of``, ``roto.sweep.trial.objective_value``)."""
 TIE_BREAK = 1e-6
 """The weight of the mean return in the ``metric`` objective: below the smallest step of a mean
 over 100 episodes of a counted metric (0.5 / 100 rotations) for returns up to 5000."""
@@ -45,7 +47,7 @@ class SweepSettings:
     """``section.key=value`` overrides every trial gets (env and agent keys) under the searched ones."""
     space: str = "roto2"
     objective: str = "return"
-    """``return`` or ``metric`` (``OBJECTIVES``)."""
+    """``return``, ``metric`` (the task's headline metric), or one of the task's metrics (``objectives_of``)."""
     trials: int = 40
     """Trials that finish (complete or pruned); failed ones are retried or replaced. Not part of the
     study's identity: rerunning with a larger count extends the study."""
@@ -66,8 +68,9 @@ class SweepSettings:
     def __post_init__(self) -> None:
         """Reject values no sweep can use."""
         check_study_name(self.study)
-        if self.objective not in OBJECTIVES:
-            raise ValueError(f"unknown objective {self.objective!r}; valid objectives: {list(OBJECTIVES)}")
+        valid = objectives_of(self.task)
+        if self.objective not in valid:
+            raise ValueError(f"unknown objective {self.objective!r} for task {self.task!r}; valid objectives: {valid}")
         for name in ("trials", "steps", "num_envs", "threads"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
@@ -90,6 +93,14 @@ class SweepSettings:
         data = {k: getattr(self, k) for k in keep}
         data["overrides"] = list(self.overrides)
         return data
+
+
+def objectives_of(task: str) -> list[str]:
+    """What a sweep of ``task`` may maximise: ``OBJECTIVES``, then each metric its evaluations
+    report (e.g. Baoding's ``round_rotations``: rotations its pair's net turning backs), with the
+    return breaking ties."""
+    found = get_task(task)
+    return [*OBJECTIVES, *found.metric_names, *found.path_metric_names]
 
 
 def trial_seed(study: str, number: int) -> int:

@@ -32,11 +32,13 @@ from roto.sweep.study import TIE_BREAK, SweepSettings, trial_seed
 
 def objective_value(record: dict[str, float], objective: str, headline_metric: str) -> float:
     """What a trial maximises from one evaluation record (``evaluations.jsonl``): its mean return
-    (``return``), or the mean of the task's ``headline_metric`` plus ``TIE_BREAK`` x the mean return
-    (``metric``: Baoding's rotations, the dense return telling apart trials that rotate alike)."""
+    (``return``), or the mean of a metric plus ``TIE_BREAK`` x the mean return: the task's
+    ``headline_metric`` for ``metric`` (Baoding's rotations), else the metric ``objective`` names
+    (Baoding's ``round_rotations``); the dense return tells apart trials that rotate alike."""
     if objective == "return":
         return record["return_mean"]
-    return record[f"{headline_metric}_mean"] + TIE_BREAK * record["return_mean"]
+    name = headline_metric if objective == "metric" else objective
+    return record[f"{name}_mean"] + TIE_BREAK * record["return_mean"]
 
 
 class Diverged(optuna.TrialPruned):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
@@ -154,9 +155,10 @@ class Baoding:
     """Rotations per 10 s of the predictive-sampling reference controller, 16 episodes each,
     ``roto demo --task baoding`` (docs/robots.md)."""
     observation_size = 8
-    path_metric_names = ("net_turns", "travelled_turns")
+    path_metric_names = ("net_turns", "travelled_turns", "round_rotations")
     """Whether the balls went round each other or swung out and back (``roto.tasks.pair_turns``): a
-    swap counts either way."""
+    swap counts either way; ``round_rotations`` counts only the rotations the pair's net turning
+    backs (min(rotations, net turns) per episode: a swing scores its net turns, about 0.25)."""
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """Two 55 g balls of the robot's Baoding diameter."""
@@ -232,7 +234,8 @@ class Baoding:
             Marker(pos=current[:, i], radius=SUCCESS_RADIUS, rgba=(*rgb, 0.35)) for i, rgb in enumerate(BALL_COLOURS)
         ]
 
-    def path_metrics(self, ball_path: torch.Tensor) -> dict[str, float]:
-        """Net and travelled turns of the line between the balls over the episode (``pair_turns``)."""
+    def path_metrics(self, ball_path: torch.Tensor, metrics: Mapping[str, float]) -> dict[str, float]:
+        """Net and travelled turns of the line between the balls over the episode (``pair_turns``),
+        and the episode's ``metrics["rotations"]`` that its net turns back."""
         net, travelled = pair_turns(ball_path)
-        return {"net_turns": net, "travelled_turns": travelled}
+        return {"net_turns": net, "travelled_turns": travelled, "round_rotations": min(metrics["rotations"], net)}

@@ -83,7 +83,7 @@ class Task(Protocol):
     observation_size: int
     """Features per world of ``observation`` (the ``task`` observation group holds one more: time left)."""
     path_metric_names: tuple[str, ...]
-    """Episode measures read from the balls' whole path (``path_metrics``), beside ``metric_names``;
+    """Episode measures read from the balls' whole path and the episode's metrics (``path_metrics``);
     evaluation reports them, training never sees them. May be empty."""
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
@@ -119,8 +119,9 @@ class Task(Protocol):
         """What pictures and videos should draw besides the scene (e.g. targets); may be empty."""
         ...
 
-    def path_metrics(self, ball_path: torch.Tensor) -> dict[str, float]:
-        """``path_metric_names`` of one episode from its balls' centres ``ball_path`` (T, n_ball, 3)."""
+    def path_metrics(self, ball_path: torch.Tensor, metrics: Mapping[str, float]) -> dict[str, float]:
+        """``path_metric_names`` of one episode from its balls' centres ``ball_path`` (T, n_ball, 3)
+        and its ``metric_names`` at its end (``metrics``)."""
         ...
 
 

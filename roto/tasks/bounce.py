@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
@@ -120,6 +121,6 @@ class Bounce:
         """None: Bounce has no targets."""
         return []
 
-    def path_metrics(self, ball_path: torch.Tensor) -> dict[str, float]:
+    def path_metrics(self, ball_path: torch.Tensor, metrics: Mapping[str, float]) -> dict[str, float]:
         """None: a bounce count says all the path does."""
         return {}

@@ -61,6 +61,8 @@ def test_a_baoding_evaluation_adds_the_pair_turns_and_leaves_the_episodes_as_the
     pairs = zip(episodes["net_turns"], episodes["travelled_turns"], strict=True)
     assert all(0.0 <= net <= travelled for net, travelled in pairs)
     assert sum(episodes["travelled_turns"]) > 0  # an untrained policy moves the balls some way
+    backed = zip(episodes["rotations"], episodes["net_turns"], strict=True)
+    assert episodes["round_rotations"] == [min(rotations, net) for rotations, net in backed]
 
 
 def test_a_bounce_evaluation_has_no_path_metrics():

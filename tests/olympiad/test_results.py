@@ -110,11 +110,11 @@ def test_path_metrics_stand_beside_the_headline_metric_and_older_summaries_say_n
     write_summaries(tmp_path / "summaries")
     newer = json.loads((tmp_path / "summaries" / "baoding-allegro-blind-ppo-seed0.json").read_text())
     newer["seed"] = 1
-    newer["best"].update({"net_turns_mean": 0.25, "travelled_turns_mean": 14.62})
+    newer["best"].update({"net_turns_mean": 0.25, "travelled_turns_mean": 14.62, "round_rotations_mean": 0.24})
     (tmp_path / "summaries" / "baoding-allegro-blind-ppo-seed1.json").write_text(json.dumps(newer))
     write_results(tmp_path / "summaries", tmp_path / "out")
     md = (tmp_path / "out" / "results.md").read_text()
-    assert "| cell | rotations (best.pt) | net_turns | travelled_turns |" in md
-    assert "| allegro / blind / ppo / seed 0 | 2.00 | not measured | not measured |" in md
-    assert "| allegro / blind / ppo / seed 1 | 2.00 | 0.25 | 14.62 |" in md
+    assert "| cell | rotations (best.pt) | net_turns | travelled_turns | round_rotations |" in md
+    assert "| allegro / blind / ppo / seed 0 | 2.00 | not measured | not measured | not measured |" in md
+    assert "| allegro / blind / ppo / seed 1 | 2.00 | 0.25 | 14.62 | 0.24 |" in md
     assert md.count("path metrics") == 1  # a table for Baoding, none for Bounce

@@ -63,6 +63,7 @@ def test_a_reference_episode_reports_the_turns_of_the_ball_pair_over_its_own_ste
         env.close()
     assert result["length"] == 30 and result["swaps"] >= 1
     assert 0.0 < result["net_turns"] <= result["travelled_turns"] + 1e-12
+    assert result["round_rotations"] == min(result["rotations"], result["net_turns"])
 
 
 def test_the_controller_needs_one_world_on_the_cpu():

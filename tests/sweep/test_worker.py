@@ -165,8 +165,24 @@ def test_a_metric_objective_ranks_trials_by_the_headline_metric_with_the_return_
     assert "| best eval headline metric (+1e-06 x return) |" in table and f"| {trial.value:.6f} |" in table
     with pytest.raises(ValueError, match=r"'objective': \('metric', 'return'\)"):
         open_study(toy_settings(tmp_path, trials=2))  # the stored objective is part of the study
-    with pytest.raises(ValueError, match=r"unknown objective 'rotations'; valid objectives: \['return', 'metric'\]"):
+    refusal = r"unknown objective 'rotations' for task 'bounce'; valid objectives: \['return', 'metric', 'bounces'\]"
+    with pytest.raises(ValueError, match=refusal):
         toy_settings(tmp_path, trials=2, objective="rotations")
+
+
+def test_an_objective_may_name_another_metric_of_the_task_with_the_return_breaking_ties():
+    from roto.sweep.report import _objective_name
+    from roto.sweep.study import SweepSettings, objectives_of
+    from roto.sweep.trial import objective_value
+
+    assert objectives_of("baoding")[-1] == "round_rotations"
+    settings = SweepSettings(study="round", task="baoding", objective="round_rotations")
+    swing = {"return_mean": 400.0, "rotations_mean": 13.27, "round_rotations_mean": 0.26}
+    round_ = {"return_mean": 300.0, "rotations_mean": 11.22, "round_rotations_mean": 11.22}
+    assert objective_value(swing, "metric", "rotations") > objective_value(round_, "metric", "rotations")
+    assert objective_value(swing, settings.objective, "rotations") == 0.26 + 1e-6 * 400.0
+    assert objective_value(round_, settings.objective, "rotations") == 11.22 + 1e-6 * 300.0
+    assert _objective_name(settings.identity()) == "round_rotations (+1e-06 x return)"
 
 
 def test_a_study_stored_before_objectives_existed_is_joined_as_a_return_study(tmp_path):

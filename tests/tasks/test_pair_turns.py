@@ -46,10 +46,21 @@ def test_a_held_pair_turns_not_at_all_and_bad_shapes_are_refused():
         pair_turns(still.reshape(50, 6))
 
 
-def test_baodings_path_metrics_are_the_pairs_net_and_travelled_turns():
+def test_baodings_path_metrics_are_the_pairs_turns_and_the_rotations_its_net_turning_backs():
     from roto.tasks.baoding import Baoding
 
-    angle = torch.linspace(0, 2 * math.pi, 201, dtype=torch.float64)
-    path = balls_around(CENTRE, angle, TILTED_U, TILTED_V, 0.02)
     task = Baoding()
-    assert task.path_metrics(path) == dict(zip(task.path_metric_names, pair_turns(path), strict=True))
+    one_turn = torch.linspace(0, 2 * math.pi, 201, dtype=torch.float64)
+    once_round = balls_around(CENTRE, one_turn, TILTED_U, TILTED_V, 0.02)
+    net, travelled = pair_turns(once_round)
+    assert net == pytest.approx(1.0)
+    metrics = task.path_metrics(once_round, {"swaps": 2.0, "rotations": 1.0})
+    assert metrics == {"net_turns": net, "travelled_turns": travelled, "round_rotations": min(1.0, net)}
+    counted_not_turned = task.path_metrics(once_round, {"swaps": 6.0, "rotations": 3.0})
+    turned_not_swapped = task.path_metrics(once_round, {"swaps": 0.0, "rotations": 0.0})
+    assert counted_not_turned["round_rotations"] == net and turned_not_swapped["round_rotations"] == 0.0
+    out_and_back = torch.cat([torch.linspace(0, math.pi, 101), torch.linspace(math.pi, 0, 101)[1:]]).to(torch.float64)
+    swing = balls_around(CENTRE, out_and_back.repeat(3), TILTED_U, TILTED_V, 0.02)  # three swings: six swaps
+    metrics = task.path_metrics(swing, {"swaps": 6.0, "rotations": 3.0})
+    assert metrics["round_rotations"] == metrics["net_turns"] < 0.01
+    assert metrics["travelled_turns"] == pytest.approx(3.0)
