@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # One prepared call of a GPU sitting: blind Shadow Bounce with bounce_gpu at 8192 envs to 200 M env
 # steps (the run stops there by itself), then, for the time left, the Shadow's Baoding recipe with
-# only round swaps paid in training (env.swap_min_turn=0.25, the aid that made ORCA carry the balls
-# round on the CPU), since at 8192 envs the plain recipe swings them (docs/results.md).
+# ORCA's round aids (baoding_cpu_shadow_round: a bank of round starts, only round swaps paid in
+# training; together they made ORCA carry the balls round on the CPU), since at 8192 envs the plain
+# recipe swings them (docs/results.md).
 #   usage (on the GPU machine, in the repo root, after `bash benchmarks/gpu_machine.sh stage .whl1`,
 #   `.whl2`, `.whl3` in three calls; .whl4 holds the last wheel part and the kernel cache archive
 #   kernels*.tar.xz.part-NN of Shadow Bounce and Baoding, so nothing compiles):
@@ -28,8 +29,8 @@ DEADLINE=$(( deadline + 35 )) PAIRS=bounce:shadow SCALING="" PYTEST_FILES="" UPD
 log "bounce done"
 if [ $(( deadline - $(date +%s) )) -gt 150 ]; then
   DEADLINE=$(( deadline + 35 )) PAIRS="" SCALING="" PYTEST_FILES="" UPDATE_AGENTS="" TRAIN_TASK=baoding \
-    TRAIN_ROBOT=shadow bash benchmarks/gpu_suite.sh "$out/baoding_round_swaps" 600 8192 \
-    --agent_cfg baoding_cpu_shadow ppo.cuda_graph=true ppo.tf32_update=true env.swap_min_turn=0.25 \
+    TRAIN_ROBOT=shadow bash benchmarks/gpu_suite.sh "$out/baoding_round" 600 8192 \
+    --agent_cfg baoding_cpu_shadow_round ppo.cuda_graph=true ppo.tf32_update=true \
     run.eval_every=20 run.checkpoint_every=40
   log "baoding done"
 fi
