@@ -19,6 +19,7 @@ def test_packaged_plans():
         "baoding_v1_low_noise",
         "baoding_v1_round",
         "baoding_v1_orca_round",
+        "baoding_v1_shadow_round",
     }
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
@@ -358,6 +359,21 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
         "baoding", "orca", "blind", "baoding_cpu_orca_round", [], plan.steps, num_envs=128, threads=1
     )
     assert packaged.differences(cell_spec(plan, Cell("baoding", "orca", "blind", "round_bank_round_swaps", 0))) == {}
+
+
+def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swaps_on_the_seed_it_swung():
+    from roto.olympiad.cell import cell_spec
+    from roto.rl.run_spec import build_run_spec
+
+    plan = load_plan("baoding_v1_shadow_round")
+    assert [c.name for c in plan.cells] == ["baoding-shadow-blind-round-seed3"] and plan.steps == 5_000_000
+    recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu_shadow", [], plan.steps, num_envs=128, threads=1)
+    round_bank = "benchmarks/results/baoding_reference/shadow_round_preswap.npz"
+    assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
+        "env.replay_starts": (round_bank, recipe.env.replay_starts), "env.swap_min_turn": (0.25, 0.0),
+        "env.seed": (3, 0),
+    }  # fmt: skip
+    assert pathlib.Path(round_bank).is_file()
 
 
 def test_the_busiest_worker_and_a_running_cells_rate():
