@@ -8,7 +8,7 @@ it answers, so the path is the one the policy saw, with no change to the episode
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import torch
@@ -51,7 +51,7 @@ class BallPathRecorder:
         return self.act(obs)
 
     def path_metrics(
-        self, task: Task, lengths: torch.Tensor, metrics: dict[str, torch.Tensor]
+        self, task: Task, lengths: torch.Tensor, metrics: Mapping[str, Sequence[float] | torch.Tensor]
     ) -> dict[str, list[float]]:
         """Each env's first episode's ``task.path_metrics``, from its first ``lengths[i]`` observations.
 
