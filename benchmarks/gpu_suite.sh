@@ -18,7 +18,7 @@
 # A short lease runs a subset, chosen by environment variables (defaults: everything):
 #   PAIRS="bounce:shadow"        the (task:robot) pairs benched (default all eight)
 #   SCALING="8192"               the env counts of the scaling line (default 1024 ... 32768)
-#   PYTEST_FILES="tests/rl/..."  the GPU test files (default the three below)
+#   PYTEST_FILES="tests/rl/..."  the GPU test files (default: every gpu-marked test under tests/)
 #   UPDATE_AGENTS="bounce bounce_cpu_quickstart"  agent configs whose update is timed (default bounce)
 #   (each of these four set to "" skips its step)
 #   DEADLINE=<epoch seconds>     training stops 60 s before it (room for the policies), whatever TRAIN_SECONDS says
@@ -45,7 +45,7 @@ step() {  # step NAME STDOUT_FILE COMMAND...: run it, log status and time, remem
 
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv > "$out/gpu.txt" 2>&1 || failed+=(nvidia-smi)
 all_pairs="bounce:shadow bounce:shadow_lite bounce:allegro bounce:orca baoding:shadow baoding:shadow_lite baoding:allegro baoding:orca"
-read -r -a pytest_files <<< "${PYTEST_FILES-tests/envs/test_sync_free_step.py tests/rl/test_training_gpu.py tests/rl/test_graphed_step.py}"
+read -r -a pytest_files <<< "${PYTEST_FILES-tests}"
 if [ ${#pytest_files[@]} -gt 0 ]; then
   step pytest_gpu "$out/pytest_gpu.txt" python3 -m pytest -q -m gpu -p no:cacheprovider "${pytest_files[@]}"
 fi
