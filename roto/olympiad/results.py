@@ -147,10 +147,24 @@ def _format(stats: dict | None) -> str:
     return f"{stats['mean']:.1f} ± {stats['std']:.1f} (IQM {stats['iqm']:.1f} {interval}, n={stats['n']})"
 
 
+def with_derived_means(task: str, evaluation: dict) -> dict:
+    """``evaluation`` (a summary's ``final`` or ``best``) with the ``<name>_mean`` of each of the
+    task's ``derived_metrics`` it lacks but can recompute from its stored episodes (``per_episode``:
+    {measure: one value per episode}); a summary written before such a measure existed gets it so."""
+    episodes = evaluation.get("per_episode") or {}
+    count = min((len(values) for values in episodes.values()), default=0)
+    derived = [get_task(task).derived_metrics({k: v[i] for k, v in episodes.items()}) for i in range(count)]
+    if not derived or not derived[0]:
+        return evaluation
+    means = {f"{name}_mean": float(np.mean([d[name] for d in derived])) for name in derived[0]}
+    return {**means, **evaluation}
+
+
 def path_metric_table(summaries: list[dict]) -> list[str]:
     """Markdown lines: each seed's ``best.pt`` headline metric beside its path metrics
     (``Task.path_metrics``, e.g. Baoding's net turns), a table per task that has them; empty if none
-    does. Summaries written before evaluations measured paths say "not measured"."""
+    does. A measure that follows from the stored episodes (``Task.derived_metrics``) is recomputed
+    where a summary lacks it; summaries written before evaluations measured paths say "not measured"."""
     lines = []
     for task in sorted({s["task"] for s in summaries}):
         names = get_task(task).path_metric_names
@@ -161,7 +175,7 @@ def path_metric_table(summaries: list[dict]) -> list[str]:
                   "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]  # fmt: skip
         for s in sorted(summaries, key=lambda s: (s["robot"], s["obs"], s["variant"], s["seed"])):
             if s["task"] == task:
-                best = s["best"]
+                best = with_derived_means(task, s["best"])
                 values = [f"{best[f'{n}_mean']:.2f}" if f"{n}_mean" in best else "not measured" for n in names]
                 cell = f"{s['robot']} / {s['obs']} / {s['variant']} / seed {s['seed']}"
                 lines.append("| " + " | ".join([cell, f"{best[f'{metric(task)}_mean']:.2f}", *values]) + " |")

@@ -236,6 +236,13 @@ class Baoding:
 
     def path_metrics(self, ball_path: torch.Tensor, metrics: Mapping[str, float]) -> dict[str, float]:
         """Net and travelled turns of the line between the balls over the episode (``pair_turns``),
-        and the episode's ``metrics["rotations"]`` that its net turns back."""
+        and the episode's ``metrics["rotations"]`` that its net turns back (``derived_metrics``)."""
         net, travelled = pair_turns(ball_path)
-        return {"net_turns": net, "travelled_turns": travelled, "round_rotations": min(metrics["rotations"], net)}
+        turns = {"net_turns": net, "travelled_turns": travelled}
+        return turns | self.derived_metrics({**metrics, **turns})
+
+    def derived_metrics(self, episode: Mapping[str, float]) -> dict[str, float]:
+        """``round_rotations`` = min(rotations, net turns), where ``episode`` has both."""
+        if "rotations" not in episode or "net_turns" not in episode:
+            return {}
+        return {"round_rotations": min(episode["rotations"], episode["net_turns"])}

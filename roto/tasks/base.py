@@ -124,6 +124,13 @@ class Task(Protocol):
         and its ``metric_names`` at its end (``metrics``)."""
         ...
 
+    def derived_metrics(self, episode: Mapping[str, float]) -> dict[str, float]:
+        """Those ``path_metric_names`` of one episode that follow from its other measures alone
+        (``episode``: its metrics and path metrics at its end), for which ``path_metrics`` uses this
+        too; a result written before such a measure existed recomputes it from its stored episodes.
+        Empty where the given measures do not include what one needs."""
+        ...
+
 
 def uniform(
     generator: torch.Generator, shape: tuple[int, ...], half_width: float, device: torch.device

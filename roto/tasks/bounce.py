@@ -124,3 +124,7 @@ class Bounce:
     def path_metrics(self, ball_path: torch.Tensor, metrics: Mapping[str, float]) -> dict[str, float]:
         """None: a bounce count says all the path does."""
         return {}
+
+    def derived_metrics(self, episode: Mapping[str, float]) -> dict[str, float]:
+        """None (no path metrics)."""
+        return {}

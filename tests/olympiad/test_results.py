@@ -118,3 +118,33 @@ def test_path_metrics_stand_beside_the_headline_metric_and_older_summaries_say_n
     assert "| allegro / blind / ppo / seed 0 | 2.00 | not measured | not measured | not measured |" in md
     assert "| allegro / blind / ppo / seed 1 | 2.00 | 0.25 | 14.62 | 0.24 |" in md
     assert md.count("path metrics") == 1  # a table for Baoding, none for Bounce
+
+
+def test_a_summary_without_round_rotations_gets_them_from_its_stored_episodes(tmp_path):
+    from roto.olympiad.results import write_results
+
+    write_summaries(tmp_path / "summaries")
+    older = tmp_path / "summaries" / "baoding-allegro-blind-ppo-seed0.json"
+    summary = json.loads(older.read_text())
+    # written before round_rotations existed: per episode min(rotations, net turns) = 0.25 and 1.0
+    summary["best"].update(
+        {
+            "net_turns_mean": 1.125,
+            "travelled_turns_mean": 3.0,
+            "per_episode": {"rotations": [3.0, 1.0], "net_turns": [0.25, 2.0], "travelled_turns": [3.0, 3.0]},
+        }
+    )
+    older.write_text(json.dumps(summary))
+    write_results(tmp_path / "summaries", tmp_path / "out")
+    md = (tmp_path / "out" / "results.md").read_text()
+    assert "| allegro / blind / ppo / seed 0 | 2.00 | 1.12 | 3.00 | 0.62 |" in md
+
+
+def test_derived_means_leave_a_measured_value_and_an_evaluation_without_episodes_as_they_are():
+    from roto.olympiad.results import with_derived_means
+
+    measured = {"round_rotations_mean": 0.5, "per_episode": {"rotations": [3.0], "net_turns": [0.25]}}
+    assert with_derived_means("baoding", measured)["round_rotations_mean"] == 0.5
+    assert with_derived_means("baoding", {"rotations_mean": 2.0}) == {"rotations_mean": 2.0}
+    bounce = {"per_episode": {"bounces": [60.0, 62.0]}}
+    assert with_derived_means("bounce", bounce) == bounce

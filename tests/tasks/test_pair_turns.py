@@ -64,3 +64,13 @@ def test_baodings_path_metrics_are_the_pairs_turns_and_the_rotations_its_net_tur
     metrics = task.path_metrics(swing, {"swaps": 6.0, "rotations": 3.0})
     assert metrics["round_rotations"] == metrics["net_turns"] < 0.01
     assert metrics["travelled_turns"] == pytest.approx(3.0)
+
+
+def test_baodings_derived_metrics_need_both_rotations_and_net_turns():
+    from roto.tasks import get_task
+
+    task = get_task("baoding")
+    assert task.derived_metrics({"rotations": 3.0, "net_turns": 0.25}) == {"round_rotations": 0.25}
+    assert task.derived_metrics({"rotations": 1.0, "net_turns": 1.4}) == {"round_rotations": 1.0}
+    assert task.derived_metrics({"rotations": 3.0}) == {}
+    assert get_task("bounce").derived_metrics({"bounces": 60.0}) == {}
