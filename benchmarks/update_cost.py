@@ -13,7 +13,9 @@ replays each minibatch step from a CUDA graph (``ppo.cuda_graph=true``), ``fused
 with the fused implementation
 (``ppo.fused_adam=true``), ``tf32`` lets the update's matrix products use TF32
 (``ppo.tf32_update=true``), ``bf16`` runs the update's forward and backward passes under bfloat16
-autocast (``ppo.bf16_update=true``); ``eager`` is none of them.
+autocast (``ppo.bf16_update=true``), ``compiled`` compiles the forward pass and loss terms with torch.compile
+(``ppo.compile_update=true``); ``eager`` is none of them. ``--profile`` adds, on a GPU, the kernels'
+device time per minibatch step from one more update under torch.profiler.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ def fill(alg: PPO, sizes: dict[str, int], generator: torch.Generator) -> None:
 
 
 GRAPH, FUSED, TF32, BF16 = "ppo.cuda_graph=true", "ppo.fused_adam=true", "ppo.tf32_update=true", "ppo.bf16_update=true"
+COMPILED = "ppo.compile_update=true"
 VARIANTS = {
     "eager": [],
     "eager_fused": [FUSED],
@@ -57,9 +60,11 @@ VARIANTS = {
     "cuda_graph_tf32": [GRAPH, TF32],
     "cuda_graph_fused": [GRAPH, FUSED],
     "cuda_graph_fused_tf32": [GRAPH, FUSED, TF32],
+    "eager_fused_tf32_compiled": [FUSED, TF32, COMPILED],
+    "cuda_graph_fused_tf32_compiled": [GRAPH, FUSED, TF32, COMPILED],
 }
 """Variant name -> the agent-config overrides it times."""
-CPU_VARIANTS = ("eager", "eager_fused", "eager_bf16")
+CPU_VARIANTS = ("eager", "eager_fused", "eager_bf16")  # compiled ones only when named (each compiles for a minute)
 GPU_VARIANTS = tuple(name for name in VARIANTS if name not in ("eager_fused", "eager_bf16"))
 
 
@@ -83,6 +88,7 @@ def measure(args: argparse.Namespace, variant: str) -> dict[str, object]:
         alg.update()  # ends with host reads of its metrics, so the device is done when it returns
         seconds.append(time.perf_counter() - start)
     median = statistics.median(seconds[1:])
+    kernels = device_time(alg, sizes, generator) if args.profile and device.type == "cuda" else {}
     samples = agent.ppo.rollouts * args.num_envs * agent.ppo.epochs
     return {
         "variant": variant,
@@ -95,6 +101,27 @@ def measure(args: argparse.Namespace, variant: str) -> dict[str, object]:
         "update_s": round(median, 5),
         "first_update_s": round(seconds[0], 3),
         "samples_per_s": round(samples / median),
+        **kernels,
+    }
+
+
+def device_time(alg: PPO, sizes: dict[str, int], generator: torch.Generator) -> dict[str, object]:
+    """One more update under torch.profiler: the GPU's busy time (the sum of its kernels' durations),
+    the number of kernels, and the five kernels that took longest in all, per minibatch step."""
+    from torch.profiler import ProfilerActivity, profile
+
+    fill(alg, sizes, generator)
+    torch.cuda.synchronize()
+    with profile(activities=[ProfilerActivity.CUDA]) as prof:
+        alg.update()
+        torch.cuda.synchronize()
+    steps = alg.config.epochs * alg.config.minibatches
+    events = [e for e in prof.key_averages() if e.device_time_total > 0]
+    top = sorted(events, key=lambda e: e.device_time_total, reverse=True)[:5]
+    return {
+        "kernel_ms_per_step": round(sum(e.device_time_total for e in events) / 1e3 / steps, 4),
+        "kernels_per_step": round(sum(e.count for e in events) / steps, 1),
+        "top_kernels_ms_per_step": {e.key[:80]: round(e.device_time_total / 1e3 / steps, 4) for e in top},
     }
 
 
@@ -107,6 +134,7 @@ def main() -> None:
     parser.add_argument("--num_envs", type=int, default=8192)
     parser.add_argument("--updates", type=int, default=6, help="timed updates per variant (the first is dropped)")
     parser.add_argument("--variants", nargs="+", default=None, choices=list(VARIANTS), help="default: see above")
+    parser.add_argument("--profile", action="store_true", help="on a GPU, add each variant's kernel time per step")
     args = parser.parse_args()
     if args.updates < 2:
         parser.error(f"--updates must be >= 2 (the first one is not counted), got {args.updates}")

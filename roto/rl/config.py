@@ -107,6 +107,11 @@ class PPOConfig:
     tf32_update: bool = False
     """Let the update's matrix products on a CUDA device use TF32 (10-bit mantissa inputs, FP32
     accumulation; torch.backends.cuda.matmul.allow_tf32) for its duration. No effect on a CPU."""
+    compile_update: bool = False
+    """Compile the update's forward pass and loss terms with torch.compile (TorchInductor fuses their
+    element-wise kernels; the backward pass is compiled with them): the same losses up to rounding,
+    fewer and larger kernels. With ``cuda_graph`` the compiled kernels are recorded into the graph.
+    The first update compiles (tens of seconds; a C compiler, and Triton on a GPU)."""
     bf16_update: bool = False
     """Run PPO's forward and backward passes in the update under bfloat16 autocast (matrix products
     with 7-bit mantissa inputs and outputs, FP32 accumulation), the rollout's actions rescored with

@@ -84,6 +84,8 @@ class PPO:
         self.aux_losses = list(aux_losses or [])
         self.lr = config.lr
         self._graphed: GraphedMinibatchStep | None = None
+        # the forward pass and loss terms, compiled into fused kernels with ``compile_update``
+        self._ppo_loss = torch.compile(self._ppo_terms, dynamic=False) if config.compile_update else self._ppo_terms
         fused = True if config.fused_adam else None  # None: PyTorch picks its default implementation
         if config.cuda_graph:
             check_graphable(config, storage, self.aux_losses)
@@ -195,19 +197,7 @@ class PPO:
     def _minibatch_step(self, batch: dict, aux: list[tuple[AuxLoss, Any]]) -> dict[str, torch.Tensor]:
         """One backward of the weighted loss terms, PPO's Adam step, then each active loss's own step."""
         c = self.config
-        mean, log_std, value, latent = self._forward(batch["obs"])
-        dist = torch.distributions.Normal(mean, log_std.exp().expand_as(mean), validate_args=False)
-        terms, diagnostics = ppo_terms(
-            dist.log_prob(batch["actions"]).sum(-1),
-            batch["log_probs"],
-            batch["advantages"],
-            value,
-            batch["values"],
-            batch["returns"],
-            dist.entropy().sum(-1),
-            ratio_clip=c.ratio_clip,
-            value_clip=c.value_clip,
-        )
+        terms, diagnostics, latent = self._ppo_loss(batch)
         weights = {"surrogate": 1.0, "value": c.value_coef, "entropy": -c.entropy_coef}
         metrics = {f"ppo/{name}": value_ for name, value_ in diagnostics.items()}
         for loss_fn, aux_batch in aux:
@@ -229,6 +219,24 @@ class PPO:
         metrics.update({f"loss/{name}": value_.detach() for name, value_ in terms.items()})
         metrics["loss/total"] = total.detach()
         return metrics
+
+    def _ppo_terms(self, batch: dict) -> tuple[dict[str, torch.Tensor], dict[str, torch.Tensor], torch.Tensor]:
+        """The forward pass on a minibatch and PPO's loss terms: (terms, diagnostics, actor latent)."""
+        c = self.config
+        mean, log_std, value, latent = self._forward(batch["obs"])
+        dist = torch.distributions.Normal(mean, log_std.exp().expand_as(mean), validate_args=False)
+        terms, diagnostics = ppo_terms(
+            dist.log_prob(batch["actions"]).sum(-1),
+            batch["log_probs"],
+            batch["advantages"],
+            value,
+            batch["values"],
+            batch["returns"],
+            dist.entropy().sum(-1),
+            ratio_clip=c.ratio_clip,
+            value_clip=c.value_clip,
+        )
+        return terms, diagnostics, latent
 
     @torch.no_grad()
     def _rescore_log_probs(self) -> None:

@@ -1,7 +1,8 @@
 """The update's speed-ups: ``ppo.cuda_graph`` (the graphed update trains as the eager one does, on a
 GPU; a setting it cannot run is refused before any training, everywhere), ``ppo.fused_adam``
 (the same update as PyTorch's default Adam, on the CPU and graphed on a GPU) and
-``ppo.bf16_update`` (the update's products in bfloat16, its steps pointing where FP32's do)."""
+``ppo.bf16_update`` (the update's products in bfloat16, its steps pointing where FP32's do) and
+``ppo.compile_update`` (the forward pass and losses compiled, training as the eager ones)."""
 
 import pytest
 import torch
@@ -95,6 +96,29 @@ def test_graphed_updates_train_as_eager_ones(kl_adaptive, fused):
     eager._graphed = None  # the same capturable Adam and lr tensor, stepped eagerly: the reference
     assert_trains_alike(eager, graphed, device, rel=1e-5, abs_=1e-7)  # the first update captures
     assert graphed.lr == pytest.approx(eager.lr)
+
+
+def test_a_compiled_update_trains_as_the_eager_one():
+    """``ppo.compile_update``: the forward pass and loss terms run as TorchInductor's fused kernels
+    (the function really is compiled) and train the weights as the eager ones do."""
+    device = torch.device("cpu")
+    flags = ["ppo.lr=1e-3", "ppo.kl_adaptive=true"]
+    eager, compiled = learner(device, flags), learner(device, [*flags, "ppo.compile_update=true"])
+    assert eager._ppo_loss == eager._ppo_terms and compiled._ppo_loss != compiled._ppo_terms
+    # Adam divides by the gradients' running scale: where a gradient is near zero, rounding apart
+    # moves a weight by up to 5e-6 (of steps of 1e-3) after three updates
+    assert_trains_alike(eager, compiled, device, rel=1e-4, abs_=2e-5)
+    assert compiled.lr == pytest.approx(eager.lr)
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_a_compiled_update_replayed_from_a_graph_trains_as_the_eager_one():
+    device = torch.device("cuda")
+    flags = ["ppo.lr=1e-3", "ppo.kl_adaptive=true", "ppo.cuda_graph=true", "ppo.fused_adam=true"]
+    eager, compiled = learner(device, flags), learner(device, [*flags, "ppo.compile_update=true"])
+    eager._graphed = None
+    assert_trains_alike(eager, compiled, device, rel=1e-4, abs_=2e-5)
 
 
 @pytest.mark.gpu
