@@ -20,7 +20,8 @@ download() {  # wheels for CPython 3.12 on x86-64 manylinux, without their depen
 }
 download "$tmp/warp" warp-lang==1.19.0
 download "$tmp/wheels" mujoco==4.0.0 mujoco-core==4.0.0 mujoco-studio==4.0.0 mujoco-warp==4.0.0 gymnasium==1.4.0 \
-  farama-notifications gymnasium-robotics==1.4.2 orca-sim==0.1.0 tensorboardX==2.6.5 etils
+  farama-notifications gymnasium-robotics==1.4.2 orca-sim==0.1.0 tensorboardX==2.6.5 etils \
+  optuna==5.0.0 colorlog sqlalchemy alembic mako tqdm  # roto.sweep: without them seven test modules do not collect
 mkdir -p "$tmp/unpacked" "$tmp/files"
 python3 -m zipfile -e "$tmp"/warp/*.whl "$tmp/unpacked"
 rm -rf "$tmp/unpacked/warp/examples"
