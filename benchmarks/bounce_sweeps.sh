@@ -2,8 +2,8 @@
 # A blind Bounce sweep per hand other than the Shadow (whose sweep made bounce_cpu_quickstart), each
 # started from the Shadow's configuration (enqueued as its first trial), at the CPU Olympiad's
 # budget of 5 M env steps, then exported as the hand's packaged config roto/configs/bounce_cpu_<hand>.yaml
-# (a diff from bounce_cpu_quickstart). Two one-thread workers; about 16 trials x 40 minutes / 2 per
-# hand, fewer when pruned. Each study's journal lives in benchmarks/results/sweeps/<study>.journal.log
+# (a diff from bounce_cpu_quickstart), unless that file has since been rewritten by hand. Two
+# one-thread workers; about 16 trials x 40 minutes / 2 per hand, fewer when pruned. Each study's journal lives in benchmarks/results/sweeps/<study>.journal.log
 # (commit it after a sitting), so rerunning continues where it stopped, on this machine or on a new
 # clone: finished trials stay finished, and interrupted ones are retried (--reclaim-now: no other
 # worker runs) from their checkpoints where runs/ still has them, from their start where not.
@@ -23,5 +23,11 @@ for robot in "${hands[@]}"; do
         --enqueue_base --num_envs 128 --threads 1 --torch_threads 1 --workers "${WORKERS:-2}" --reclaim-now \
         --storage "$journal"
     roto sweep show --study "$study" --storage "$journal" > "benchmarks/results/sweeps/$study.md"
-    roto sweep export --study "$study" --storage "$journal" --out "roto/configs/bounce_cpu_$robot.yaml"
+    config="roto/configs/bounce_cpu_$robot.yaml"
+    # a config written after its export was checked on more seeds (bounce_cpu_allegro) is not overwritten
+    if [[ ! -f $config ]] || head -1 "$config" | grep -q '^# roto sweep export:'; then
+        roto sweep export --study "$study" --storage "$journal" --out "$config"
+    else
+        echo "$config is not a sweep's export (checked on more seeds, docs/sweeps.md): left as it is" >&2
+    fi
 done

@@ -132,10 +132,12 @@ def test_every_packaged_diff_config_differs_from_its_base_only_where_it_says():
         aids = data.pop("training_aids", {})  # the env's, not the agent's (tests/rl/test_run_spec.py)
         assert to_dict(load_agent_config(task, name)) == to_dict(from_dict(AgentConfig, merge(base, data)))
         changed = {f"{s}.{k}" for s, section in data.items() for k in section} | set(aids)
-        # a sweep's export whose best trial was the base it enqueued says so and changes nothing
+        # a sweep's export whose best trial was the base it enqueued says so and changes nothing, as
+        # does a config whose sweep's best did not hold up on other seeds ("keeps its base")
         header = path.read_text().splitlines()[0]
         found_base_best = header.startswith("# roto sweep export:") and "trial 0 (the best)" in header
-        assert changed or found_base_best, f"{name} extends its base without changing anything"
+        kept_base = "keeps its base" in header
+        assert changed or found_base_best or kept_base, f"{name} extends its base without changing anything"
 
 
 @pytest.mark.parametrize(
