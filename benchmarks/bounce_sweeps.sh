@@ -4,9 +4,10 @@
 # budget of 5 M env steps, then exported as the hand's packaged config roto/configs/bounce_cpu_<hand>.yaml
 # (a diff from bounce_cpu_quickstart), unless that file has since been rewritten by hand. Two
 # one-thread workers; about 16 trials x 40 minutes / 2 per hand, fewer when pruned. Each study's
-# journal lives in benchmarks/results/sweeps/<study>.journal.log (commit it after a sitting), so rerunning continues where it stopped, on this machine or on a new
-# clone: finished trials stay finished, and interrupted ones are retried (--reclaim-now: no other
-# worker runs) from their checkpoints where runs/ still has them, from their start where not.
+# journal lives in benchmarks/results/sweeps/<study>.journal.log (commit it after a sitting), so
+# rerunning continues where it stopped, on this machine or on a new clone: finished trials stay
+# finished, and interrupted ones are retried (--reclaim-now: no other worker runs) from their
+# checkpoints where runs/ still has them, from their start where not.
 #     bash benchmarks/bounce_sweeps.sh [hand ...]      (default: shadow_lite allegro orca)
 #     WORKERS=1 bash benchmarks/bounce_sweeps.sh shadow_lite   (one worker, beside another job)
 set -euo pipefail
