@@ -52,14 +52,14 @@ def rhythm(contact: np.ndarray, bounce: np.ndarray, height: np.ndarray, lengths:
         min_flight_share: share of counted flights exactly ``MIN_FLIGHT_STEPS`` long (the rule's floor);
         short_touches: touches per episode that did not count (a flight under ``MIN_FLIGHT_STEPS``).
     """
-    periods, touches, flights, apexes, short, counted_all = [], [], [], [], 0, []
+    periods, touches, flights, apexes, short, total = [], [], [], [], 0, 0
     num_envs = contact.shape[1]
     for b in range(num_envs):
         n = int(lengths[b])
         counted = set(np.flatnonzero(bounce[:n, b]).tolist())
         runs = _runs(contact[:n, b])
         periods.extend(np.diff(sorted(counted)).tolist())
-        counted_all.extend(counted)
+        total += len(counted)
         for (prev_start, prev_len), (start, length) in itertools.pairwise(runs):
             if start not in counted:
                 short += 1
@@ -70,7 +70,7 @@ def rhythm(contact: np.ndarray, bounce: np.ndarray, height: np.ndarray, lengths:
             apexes.append(100.0 * float(height[left:start, b].max() - height[left - 1, b]))
     flights_arr = np.asarray(flights, dtype=np.float64)
     return {
-        "bounces": len(counted_all) / num_envs,
+        "bounces": total / num_envs,
         "steps": float(np.mean(lengths)),
         "period_steps": _mean(periods),
         "touch_steps": _mean(touches),
@@ -88,10 +88,11 @@ def record_rhythm(
     """(contact, bounce, height), each (T, B), and lengths (B,) of the first episode of every env
     under ``model``'s deterministic policy on Bounce (CPU backend, ``settings``' env): ``rhythm``'s
     inputs. An episode's last step (where the env starts the next one) is left out of its length."""
+    if settings.env.task != "bounce":
+        raise ValueError(f"the bounce rhythm needs a Bounce run (task 'bounce'), got task {settings.env.task!r}")
+    if envs < 1:
+        raise ValueError(f"the bounce rhythm needs envs >= 1, got {envs}")
     env = RotoEnv(with_ball_state(settings.cpu_env_config(num_envs=envs, seed=seed)))
-    if env.task.name != "bounce":
-        env.close()
-        raise ValueError(f"the bounce rhythm needs a Bounce run, got task {env.task.name!r}")
     obs, _ = env.reset(seed=seed)
     steps = env.config.episode_steps
     contact, bounce, height = [], [], []

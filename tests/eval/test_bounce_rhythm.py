@@ -71,3 +71,11 @@ def test_recorded_episodes_match_the_envs_own_count():
     inside = np.arange(60)[:, None] < lengths  # each env's first episode
     assert np.array_equal(bounce & inside, counted(contact) & inside)
     assert (height[:5] > 0.05).all()  # the ball spawns 10 cm above the palm and starts falling
+
+
+@pytest.mark.parametrize(("task", "envs", "named"), [("baoding", 2, "'baoding'"), ("bounce", 0, "got 0")])
+def test_a_run_of_another_task_or_no_envs_is_refused_by_name(task, envs, named):
+    settings = TrainSettings(env=EnvConfig(task=task, robot="shadow", num_envs=2, threads=1))
+    policy = ActorCritic({"tactile": 68, "proprio": 320}, 20, actor_groups=("tactile", "proprio"), encoder=(16,))
+    with pytest.raises(ValueError, match=named):
+        record_rhythm(policy, settings, envs=envs)
