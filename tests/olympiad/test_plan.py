@@ -16,6 +16,7 @@ def test_packaged_plans():
         "baoding_v1_more_aids",
         "baoding_v1_shadow_more_aids",
         "bounce_long_shadow",
+        "bounce_shadow_probes",
         "baoding_v1_low_noise",
         "baoding_v1_round",
         "baoding_v1_orca_round",
