@@ -17,6 +17,7 @@ def test_packaged_plans():
         "baoding_v1_shadow_more_aids",
         "bounce_long_shadow",
         "bounce_shadow_probes",
+        "bounce_allegro_probe",
         "baoding_v1_low_noise",
         "baoding_v1_round",
         "baoding_v1_orca_round",
