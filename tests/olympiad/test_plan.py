@@ -3,6 +3,7 @@ import pathlib
 import pytest
 
 from roto.olympiad.plan import Cell, load_plan, packaged_plans
+from roto.rl.config import load_agent_config
 
 
 def test_packaged_plans():
@@ -32,6 +33,10 @@ def test_packaged_plans():
         f"bounce-shadow-{obs}-ppo-seed{s}" for obs in ("state", "proprio") for s in (0, 1)
     }
     assert [c.seed for c in cpu.cells] == sorted(c.seed for c in cpu.cells)  # every first seed before a second
+    for robot in ("shadow", "shadow_lite", "allegro", "orca"):  # each hand's own swept Bounce config
+        assert cpu.variants["ppo"].agent_for("bounce", robot) == (f"bounce_cpu_{robot}", [])
+    shadow, orca = (load_agent_config("bounce", f"bounce_cpu_{r}") for r in ("shadow", "orca"))
+    assert shadow == load_agent_config("bounce", "bounce_cpu_quickstart") and orca.ppo.lr != shadow.ppo.lr
     long = load_plan("bounce_long_shadow")
     assert [c.name for c in long.cells] == [f"bounce-shadow-blind-quickstart-seed{s}" for s in (0, 1)]
     assert long.steps == 20_000_000 and long.variants["quickstart"].agent_for("bounce") == ("bounce_cpu_quickstart", [])
