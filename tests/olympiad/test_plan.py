@@ -26,11 +26,14 @@ def test_packaged_plans():
     }
     cpu = load_plan("cpu")
     names = [c.name for c in cpu.cells]
-    assert len(names) == 16 and cpu.steps == 5_000_000 and cpu.eval_episodes == 100
+    assert len(names) == 28 and cpu.steps == 5_000_000 and cpu.eval_episodes == 100
     assert sum(n.startswith("bounce-") and "-blind-" in n for n in names) == 8  # 4 hands x 2 seeds
     assert sum(n.startswith("baoding-") for n in names) == 4  # 4 hands x 1 seed
     assert {n for n in names if "-blind-" not in n} == {
-        f"bounce-shadow-{obs}-ppo-seed{s}" for obs in ("state", "proprio") for s in (0, 1)
+        f"bounce-{robot}-{obs}-ppo-seed{s}"
+        for robot in ("shadow", "shadow_lite", "allegro", "orca")
+        for obs in ("state", "proprio")
+        for s in (0, 1)
     }
     assert [c.seed for c in cpu.cells] == sorted(c.seed for c in cpu.cells)  # every first seed before a second
     for robot in ("shadow", "shadow_lite", "allegro", "orca"):  # each hand's own swept Bounce config
@@ -98,8 +101,8 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
     out = capsys.readouterr().out
     assert "bounce-shadow-blind-ppo-seed0" in out and out.count(" done\n") == 1
-    # 15 cells left x 5 M steps at 5000 env steps/s = 15000 s
-    assert "1 done, 15 left; time left: 4.2 h for one worker at 5000 env steps/s" in out
+    # 27 cells left x 5 M steps at 5000 env steps/s = 27000 s
+    assert "1 done, 27 left; time left: 7.5 h for one worker at 5000 env steps/s" in out
     assert not (tmp_path / "cpu").exists()  # a dry run creates no study
     started = tmp_path / "cpu" / "bounce-allegro-blind-ppo-seed0"  # a cell's run, 2.5 M steps in
     started.mkdir(parents=True)
@@ -110,25 +113,25 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     out = capsys.readouterr().out
     assert "bounce-allegro-blind-ppo-seed0" in out
     assert "(2.5 M env steps; last evaluation 27.25 bounces, best 31.50 at 1.2 M)" in out
-    assert "time left: 4.0 h for one worker" in out  # (75 M - 2.5 M) / 5000 env steps/s = 14500 s
+    assert "time left: 7.4 h for one worker" in out  # (135 M - 2.5 M) / 5000 env steps/s = 26500 s
     assert main(["olympiad", "cpu", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
                  str(results)]) == 0  # fmt: skip
-    # 14 cells of 5 M and one of 2.5 M over two workers: 37.5 M on the busier one = 7500 s
-    assert "with 2 workers at 5000 env steps/s each (the finished cells' throughput): 2.1 h" in capsys.readouterr().out
+    # 26 cells of 5 M and one of 2.5 M over two workers: 67.5 M on the busier one = 13500 s
+    assert "with 2 workers at 5000 env steps/s each (the finished cells' throughput): 3.8 h" in capsys.readouterr().out
     assert sorted(p.name for p in (tmp_path / "cpu").iterdir()) == [started.name]  # still no study
     assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
     assert f"time left: unknown: no finished cell's summary in {tmp_path / 'none'}" in capsys.readouterr().out
     timed = [{**r, "train_wall_s": r["env_steps"] / 2500} for r in rounds]  # 2500 env steps/s between its rounds
     (started / "evaluations.jsonl").write_text("".join(json.dumps(r) + "\n" for r in timed))
     assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
-    # no finished cell: the started cell's throughput, (80 M - 2.5 M) / 2500 env steps/s = 31000 s
-    assert "time left: 8.6 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
+    # no finished cell: the started cell's throughput, (140 M - 2.5 M) / 2500 env steps/s = 55000 s
+    assert "time left: 15.3 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
         capsys.readouterr().out
     )
     assert main(["olympiad", "cpu", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
                  str(tmp_path / "none")]) == 0  # fmt: skip
-    # 15 cells of 5 M and one of 2.5 M over two workers: 40 M on the busier one = 16000 s
-    assert "with 2 workers at 2500 env steps/s each (the started cells' last evaluation rounds): 4.4 h" in (
+    # 27 cells of 5 M and one of 2.5 M over two workers: 70 M on the busier one = 28000 s
+    assert "with 2 workers at 2500 env steps/s each (the started cells' last evaluation rounds): 7.8 h" in (
         capsys.readouterr().out
     )
 
