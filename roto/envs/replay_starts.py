@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import dataclasses
 import pathlib
+import zipfile
+import zlib
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 import torch
 
+from roto.envs.config import EnvConfig
 from roto.sim.mujoco_cpu import state_offsets
 
 
@@ -56,33 +59,97 @@ class ReplayBank:
         return cls(state["qpos"], state["qvel"], state["target"], state["task"]).to(device)
 
 
-def load_replay_bank(path: str, model: mujoco.MjModel, robot: str, task_state: object, num_actions: int) -> ReplayBank:
-    """The states of ``path`` (arrays ``physics`` (n, nstate) ``mjSTATE_FULLPHYSICS``, ``target``
-    (n, n_act), ``robot`` and task state fields) for ``model`` of ``robot``; task fields are the
-    arrays named like a field of ``task_state``.
+BANK_BOUND = 1e3
+"""The largest magnitude a bank's value may have: recorded positions (m, rad), velocities and
+joint targets of a hand the size of a hand stay far below it; NaN, inf or 1e30 are a broken file."""
+
+BANK_TASK = "baoding"
+"""The task a bank without a ``task`` entry was recorded on (the only task ``roto demo`` records)."""
+
+
+def read_bank(path: str | pathlib.Path) -> dict[str, np.ndarray]:
+    """The arrays of the ``.npz`` bank ``path``, read without pickle.
 
     Raises:
-        ValueError naming the file when it is missing, of another robot, of another model or holds
-        no state.
+        ValueError naming the file and what is wrong with it in one line (missing, a directory,
+        not an ``.npz``, truncated or corrupted, or holding object arrays), never loading unsafely.
     """
+    where = f"replay_starts {str(path)!r}"
     if not pathlib.Path(path).is_file():  # checked here, where it is read: a run's config stays loadable without it
+        what = "is a directory" if pathlib.Path(path).is_dir() else "is not a file"
         raise ValueError(
-            f"replay_starts {str(path)!r} is not a file (a relative path is read from the current directory, "
-            f"{str(pathlib.Path.cwd())!r}; the packaged configs' banks are relative to the repository root)"
+            f"{where} {what} (a relative path is read from the current directory, {str(pathlib.Path.cwd())!r}; "
+            "the packaged configs' banks are relative to the repository root)"
         )
-    with np.load(path, allow_pickle=False) as saved:
-        arrays = {name: saved[name] for name in saved.files}
-    if "robot" in arrays and str(arrays["robot"]) != robot:
-        raise ValueError(f"replay_starts {path!r}: states of robot {str(arrays['robot'])!r}, not {robot!r}")
+    with open(path, "rb") as file:
+        head = file.read(6)
+    if not head.startswith(b"PK"):  # an .npz is a zip archive of .npy arrays
+        found = "a single .npy array" if head == b"\x93NUMPY" else f"a file starting {head!r}"
+        raise ValueError(f"{where} is not an .npz archive of named arrays: found {found}")
+    try:
+        with np.load(path, allow_pickle=False) as saved:
+            return {name: saved[name] for name in saved.files}
+    except ValueError as error:
+        if "pickle" not in str(error):
+            raise
+        raise ValueError(
+            f"{where} holds object arrays (pickled Python objects), which roto never loads; banks hold "
+            "plain arrays, as `roto demo --task baoding --preswap_out` writes them"
+        ) from None
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, KeyError) as error:
+        reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+        raise ValueError(f"{where} is truncated or corrupted, not a readable .npz: {reason}") from None
+
+
+def check_bank(path: str, arrays: dict[str, np.ndarray], task: str, robot: str, sizes: tuple[int, int]) -> None:
+    """Refuse a bank recorded on another task or robot, of another shape than ``sizes`` (state
+    values, actions) or with a value that is not finite or beyond ``BANK_BOUND``.
+
+    Raises:
+        ValueError naming the file, what was expected and what was found.
+    """
+    where = f"replay_starts {path!r}"
+    for name, own in (("task", task), ("robot", robot)):
+        found = str(arrays[name]) if name in arrays else (BANK_TASK if name == "task" else own)
+        if found != own:
+            raise ValueError(f"{where}: states recorded on {name} {found!r}, not this env's {own!r}")
     physics, target = arrays.get("physics"), arrays.get("target")
-    nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS.value)
     if physics is None or target is None or physics.ndim != 2 or len(physics) == 0:
-        raise ValueError(f"replay_starts {path!r}: needs non-empty arrays 'physics' (n, nstate) and 'target'")
+        raise ValueError(f"{where}: needs non-empty arrays 'physics' (n, nstate) and 'target'")
+    nstate, num_actions = sizes
     if physics.shape[1] != nstate or target.shape != (len(physics), num_actions):
         raise ValueError(
-            f"replay_starts {path!r}: states of {physics.shape[1]} values and targets of shape {target.shape} do not "
+            f"{where}: states of {physics.shape[1]} values and targets of shape {target.shape} do not "
             f"fit this scene ({nstate} values, {num_actions} actions)"
         )
+    for name in ("physics", "target"):
+        values = arrays[name]
+        if not np.issubdtype(values.dtype, np.number):
+            raise ValueError(f"{where}: array {name!r} holds {values.dtype} values, not numbers")
+        bad = ~np.isfinite(values) | (np.abs(values) > BANK_BOUND)
+        if bad.any():
+            row, column = np.argwhere(bad)[0]
+            raise ValueError(
+                f"{where}: array {name!r} holds {int(bad.sum())} values that are not finite or beyond "
+                f"+-{BANK_BOUND:g} (first: {float(values[row, column])} in state {row}); a bank holds recorded states"
+            )
+
+
+def load_replay_bank(
+    path: str, model: mujoco.MjModel, robot: str, task: str, task_state: object, num_actions: int
+) -> ReplayBank:
+    """The states of ``path`` (arrays ``physics`` (n, nstate) ``mjSTATE_FULLPHYSICS``, ``target``
+    (n, n_act), ``robot``, ``task`` and task state fields) for ``model`` of ``robot`` in ``task``;
+    task fields are the arrays named like a field of ``task_state``.
+
+    Raises:
+        ValueError naming the file when it is missing, unreadable, of another robot, task or model,
+        holds no state or values no hand records (``check_bank``).
+    """
+    arrays = read_bank(path)
+    nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS.value)
+    check_bank(path, arrays, task, robot, (nstate, num_actions))
+    physics, target = arrays["physics"], arrays["target"]
     qpos0, qvel0 = state_offsets(model)
     fields = {f.name for f in dataclasses.fields(task_state)}
     return ReplayBank(
@@ -91,3 +158,18 @@ def load_replay_bank(path: str, model: mujoco.MjModel, robot: str, task_state: o
         target=torch.from_numpy(target.astype(np.float64)),
         task={name: torch.from_numpy(value.copy()) for name, value in arrays.items() if name in fields},
     )
+
+
+def check_replay_starts(config: EnvConfig) -> None:
+    """Read and check the bank ``config`` names against its hand's scene as its envs will, without
+    building them: so a run, a plan or a sweep is refused before it creates anything."""
+    if config.replay_starts is None:
+        return
+    from roto.robots import get_robot
+    from roto.sim.scene import build_scene
+    from roto.tasks import get_task
+
+    task, robot = get_task(config.task), get_robot(config.robot)
+    model, _ = build_scene(robot, task.balls(robot), config.touch)
+    state = task.init_state(robot, 1, torch.device("cpu"))
+    load_replay_bank(config.replay_starts, model, robot.name, task.name, state, robot.num_actions)

@@ -370,7 +370,8 @@ class RotoEnv:
         path = self.config.replay_starts
         if path is None:
             return None
-        return load_replay_bank(path, self.model, self.robot.name, self.task_state, self.num_actions).to(self.device)
+        bank = load_replay_bank(path, self.model, self.robot.name, self.task.name, self.task_state, self.num_actions)
+        return bank.to(self.device)
 
     def _draw_candidates(self, n: int, generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
         """n candidate starts (``roto.envs.start_draw.draw_candidates``), drawn from ``generator``

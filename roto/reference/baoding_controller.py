@@ -156,6 +156,7 @@ def save_preswap_states(path, robot: str, states: PreswapStates) -> None:
     np.savez_compressed(
         path,
         robot=np.array(robot),
+        task=np.array("baoding"),
         lead_steps=np.array(states.lead, dtype=np.int64),
         physics=np.array(states.physics).reshape(len(states.physics), -1),
         target=np.array(states.target).reshape(len(states.target), -1),

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from roto.envs.config import EnvConfig
+from roto.envs.replay_starts import check_replay_starts
 from roto.rl.config import AgentConfig, load_agent_config, load_training_aids, to_dict
 from roto.rl.overrides import apply_env_overrides, split_overrides
 from roto.rl.settings import TrainSettings
@@ -89,6 +90,7 @@ def build_run_spec(
     env = training_env(EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields), agent_cfg, env_changes)
     agent = load_agent_config(task, agent_cfg, agent_overrides)
     TrainSettings(env=env, total_steps=steps)  # checks the budget
+    check_replay_starts(env)  # the bank is read now, not when a run, a plan's cell or a sweep's trial starts
     return RunSpec(env=env, agent=agent, steps=steps)
 
 

@@ -109,7 +109,13 @@ def trial_seed(study: str, number: int) -> int:
 
 
 def open_study(settings: SweepSettings) -> tuple[optuna.Study, optuna.storages.BaseStorage]:
-    """Create the study, or join it when it exists (its stored settings must match these)."""
+    """Create the study, or join it when it exists (its stored settings must match these). The
+    base run is checked first (its agent config, overrides and bank), so a refused sweep creates
+    no study that would then hold the name."""
+    from roto.rl.run_spec import build_run_spec
+
+    base = (settings.task, settings.robot, settings.obs, settings.agent_cfg, settings.overrides, settings.steps)
+    build_run_spec(*base, num_envs=settings.num_envs, threads=settings.threads)
     storage = open_storage(settings.study_dir, settings.storage)
     # constant liar: parallel workers' running trials count as bad, so they do not all sample the same region
     sampler = optuna.samplers.TPESampler(multivariate=True, n_startup_trials=settings.startup, constant_liar=True)

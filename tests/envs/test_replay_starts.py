@@ -120,7 +120,7 @@ def test_a_missing_states_file_is_refused_by_the_env_and_a_run_s_config_still_lo
 
 
 def test_states_of_another_hand_are_refused():
-    with pytest.raises(ValueError, match=r"states of robot 'shadow', not 'allegro'"):
+    with pytest.raises(ValueError, match=r"states recorded on robot 'shadow', not this env's 'allegro'"):
         roto.make("baoding", robot="allegro", replay_starts=BANK, replay_share=0.5)
 
 
