@@ -27,6 +27,28 @@ def test_a_directory_or_a_missing_file_is_a_clear_error(tmp_path):
         read_yaml(tmp_path / "missing.yaml", "plan")
 
 
+def test_a_key_given_twice_is_refused_naming_both_lines(tmp_path, capsys):
+    path = tmp_path / "twice.yaml"
+    path.write_text("ppo:\n  lr: 1.0e-3\nnetwork:\n  encoder: [16]\nppo:\n  epochs: 2\n")
+    with pytest.raises(
+        ValueError, match=rf"agent config '{path}': key 'ppo' appears twice in one mapping, at lines 1 and 5"
+    ):
+        load_agent_config("bounce", str(path))
+    run_dir = tmp_path / "run"
+    assert main(["train", "--steps", "16", "--agent_cfg", str(path), "--run_dir", str(run_dir)]) == 2
+    assert "key 'ppo' appears twice" in capsys.readouterr().err and not run_dir.exists()
+    nested = tmp_path / "nested.yaml"
+    nested.write_text("ppo: {lr: 1.0e-3, lr: 2.0e-3}\n")
+    with pytest.raises(ValueError, match="key 'lr' appears twice in one mapping, at lines 1 and 1"):
+        read_yaml(nested)
+
+
+def test_a_merge_may_override_the_keys_it_brings_in(tmp_path):
+    path = tmp_path / "merge.yaml"
+    path.write_text("base: &base {lr: 1, epochs: 2}\nrun:\n  <<: *base\n  lr: 3\n")
+    assert read_yaml(path)["run"] == {"lr": 3, "epochs": 2}
+
+
 @pytest.mark.parametrize(
     ("load", "what"),
     [
