@@ -23,12 +23,18 @@ def make(
 ) -> RotoEnv:
     """A batched roto environment (see ``roto.envs.config.EnvConfig`` for every option).
 
-    Task and robot names are case-insensitive. Unknown names raise ``ValueError`` listing the
-    valid ones.
+    Task and robot names are case-insensitive. Unknown names and options raise ``ValueError``
+    listing the valid ones.
     """
+    import dataclasses
+
     from roto.envs.config import EnvConfig
     from roto.envs.roto_env import RotoEnv
 
+    valid = sorted(f.name for f in dataclasses.fields(EnvConfig) if f.name not in ("task", "robot"))
+    unknown = sorted(set(options) - set(valid))
+    if unknown:
+        raise ValueError(f"unknown env option(s) {unknown}; valid options: {valid}")
     config = EnvConfig(
         task=get_task(task).name,
         robot=get_robot(robot).name,
@@ -54,6 +60,26 @@ def gym_id(task: str, robot: str) -> str:
     return f"roto/{spec.display_name}-{get_robot(robot).display_name}-v{spec.version}"
 
 
+def check_id_pair(env_id: str, task: str, robot: str) -> None:
+    """Refuse a task or robot that contradicts the Gymnasium id ``env_id`` an env is made under
+    (Gymnasium lets ``gymnasium.make(id, robot=...)`` override the id's own kwargs).
+
+    Raises:
+        ValueError naming the id, what it fixes, the contradicting kwargs and the id to use.
+    """
+    fixed = next((pair for pair in list_envs() if gym_id(*pair) == env_id), None)
+    if fixed is None:
+        raise ValueError(f"{env_id!r} is not a roto Gymnasium id; valid ids: {[gym_id(*p) for p in list_envs()]}")
+    given = (get_task(task).name, get_robot(robot).name)
+    if given != fixed:
+        named = {"task": (task, fixed[0], given[0]), "robot": (robot, fixed[1], given[1])}
+        wrong = {name: value for name, (value, own, mine) in named.items() if own != mine}
+        raise ValueError(
+            f"{env_id} is task {fixed[0]!r} on robot {fixed[1]!r}; the kwargs {wrong} contradict it: "
+            f"make {gym_id(*given)} instead"
+        )
+
+
 def register_gymnasium_envs() -> None:
     """Register every pair with Gymnasium (string entry points; idempotent)."""
     import gymnasium
@@ -66,6 +92,6 @@ def register_gymnasium_envs() -> None:
             id=env_id,
             entry_point="roto.envs.gym_adapters:RotoSingleEnv",
             vector_entry_point="roto.envs.gym_adapters:RotoVectorEnv",
-            kwargs={"task": task, "robot": robot},
+            kwargs={"task": task, "robot": robot, "env_id": env_id},
             disable_env_checker=True,
         )

@@ -14,7 +14,7 @@ from gymnasium.vector.utils import batch_space
 
 from roto.envs.roto_env import RotoEnv
 from roto.envs.single_world import SingleWorldStep, single_world_result, supports_single_world_step
-from roto.registry import make
+from roto.registry import check_id_pair, make
 
 
 def _to_numpy(tree: Any) -> Any:
@@ -42,7 +42,9 @@ class RotoVectorEnv(gym.vector.VectorEnv):
 
     metadata: ClassVar[dict[str, Any]] = {"autoreset_mode": gym.vector.AutoresetMode.SAME_STEP, "render_modes": []}
 
-    def __init__(self, task: str, robot: str, num_envs: int = 1, **kwargs: Any) -> None:
+    def __init__(self, task: str, robot: str, num_envs: int = 1, env_id: str | None = None, **kwargs: Any) -> None:
+        if env_id is not None:  # made through a Gymnasium id: the id fixes the pair
+            check_id_pair(env_id, task, robot)
         self.env = make(task, robot=robot, num_envs=num_envs, **kwargs)
         self.num_envs = num_envs
         self.single_observation_space = self.env.observation_space
@@ -79,8 +81,14 @@ class RotoSingleEnv(gym.Env):
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
 
-    def __init__(self, task: str, robot: str, **kwargs: Any) -> None:
-        kwargs.pop("num_envs", None)
+    def __init__(self, task: str, robot: str, env_id: str | None = None, num_envs: int = 1, **kwargs: Any) -> None:
+        if env_id is not None:  # made through a Gymnasium id: the id fixes the pair
+            check_id_pair(env_id, task, robot)
+        if num_envs != 1:
+            raise ValueError(
+                f"num_envs={num_envs!r}: a single Gymnasium env is one world; for N worlds use "
+                "gymnasium.make_vec(id, num_envs=N, vectorization_mode='vector_entry_point')"
+            )
         self.env = make(task, robot=robot, num_envs=1, **kwargs)
         self.observation_space = self.env.observation_space
         self.action_space = self.env.action_space

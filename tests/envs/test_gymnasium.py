@@ -1,3 +1,5 @@
+import re
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -84,4 +86,29 @@ def test_touch_is_a_gymnasium_kwarg_and_sizes_the_tactile_space(touch):
     inner = env.unwrapped.env
     assert env.observation_space["tactile"].shape == (inner.frame_sizes["tactile"] * inner.config.frame_stack,)
     assert inner.config.touch == touch
+    env.close()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"robot": "allegro"}, "the kwargs {'robot': 'allegro'} contradict it: make roto/Baoding-Allegro-v"),
+        ({"task": "bounce"}, "the kwargs {'task': 'bounce'} contradict it: make roto/Bounce-Shadow-v"),
+        ({"foo": 1}, "unknown env option(s) ['foo']; valid options: ['action_smoothing'"),
+        ({"num_envs": 5}, "num_envs=5: a single Gymnasium env is one world"),
+    ],
+)
+def test_an_id_fixes_its_task_and_robot_and_its_kwargs_are_checked(kwargs, words):
+    env_id = gym_id("baoding", "shadow")
+    with pytest.raises(ValueError) as refused:
+        gym.make(env_id, **kwargs)
+    assert words in str(refused.value)
+    if "num_envs" not in kwargs:
+        with pytest.raises(ValueError, match=re.escape(words)):
+            gym.make_vec(env_id, num_envs=2, vectorization_mode="vector_entry_point", **kwargs)
+
+
+def test_an_id_accepts_its_own_task_and_robot_in_any_case():
+    env = gym.make(gym_id("baoding", "shadow"), task="Baoding", robot="SHADOW")
+    assert (env.unwrapped.env.config.task, env.unwrapped.env.config.robot) == ("baoding", "shadow")
     env.close()
