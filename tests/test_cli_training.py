@@ -219,6 +219,60 @@ def test_resume_refuses_overrides_and_a_budget_below_what_is_done(trained_run, c
     assert (trained_run / "config.yaml").read_bytes() == config  # a refused resume rewrites nothing
 
 
+@pytest.mark.parametrize(
+    "flags, named",
+    [
+        (
+            "--num_envs 999 --seed 7 --robot allegro --task baoding --obs state --agent_cfg X --touch force",
+            "--agent_cfg, --num_envs, --obs, --robot, --seed, --task, --touch would be ignored: drop them",
+        ),
+        ("--num-envs=4", "--num_envs would be ignored: drop it"),  # even at the run's own value
+        (
+            "--backend warp --device cuda --run_dir elsewhere ppo.lr=1e-3",
+            "--backend, --device, --run_dir, the overrides ['ppo.lr=1e-3'] would be ignored",
+        ),
+    ],
+)
+def test_resume_refuses_every_flag_it_would_ignore_naming_them(trained_run, flags, named, capsys):
+    config = (trained_run / "config.yaml").read_bytes()
+    assert main(["train", "--resume", str(trained_run), "--no_progress", *flags.split()]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and named in err
+    assert (trained_run / "config.yaml").read_bytes() == config
+
+
+def test_resume_takes_its_budget_and_threads_from_the_command_line(trained_run, capsys):
+    assert main(["train", "--resume", str(trained_run), "--steps", "80", "--threads", "2", "--no_progress"]) == 0
+    assert json.loads(capsys.readouterr().out.strip().splitlines()[-1])["env_steps"] == 80
+
+
+def relabelled(checkpoint, path, **env):
+    """A copy of ``checkpoint`` at ``path`` whose env section says ``env``."""
+    import torch
+
+    state = torch.load(checkpoint, weights_only=True)
+    state["train"]["env"].update(env)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    torch.save(state, path)
+    return str(path)
+
+
+def test_eval_refuses_a_checkpoint_whose_labels_do_not_fit_its_weights(trained_run, tmp_path, capsys):
+    latest = trained_run / "checkpoints" / "latest.pt"
+    other_hand = relabelled(latest, tmp_path / "loose" / "allegro.pt", robot="allegro")
+    assert main(["eval", "--checkpoint", other_hand, "--episodes", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "bounce on allegro (blind), which the checkpoint names, gives" in err
+    assert "its labels do not belong to its weights" in err and not (tmp_path / "loose" / "allegro.eval.json").exists()
+    copied = tmp_path / "run"  # the same sizes (blind Bounce and Baoding read the same groups), inside its run
+    (copied / "checkpoints").mkdir(parents=True)
+    (copied / "config.yaml").write_bytes((trained_run / "config.yaml").read_bytes())
+    other_task = relabelled(latest, copied / "checkpoints" / "best.pt", task="baoding")
+    assert main(["eval", "--checkpoint", other_task, "--episodes", "2"]) == 2
+    err = capsys.readouterr().err
+    assert "names {'task': ('baoding', 'bounce')} (checkpoint, run), unlike its run's" in err and err.count("\n") == 1
+
+
 def test_eval_into_a_missing_directory_fails_before_evaluating(trained_run, tmp_path, capsys):
     out = tmp_path / "nowhere" / "eval.json"
     assert main(["eval", "--checkpoint", str(trained_run / "checkpoints" / "latest.pt"), "--out", str(out)]) == 2

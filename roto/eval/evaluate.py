@@ -11,6 +11,7 @@ import torch
 from roto.envs.ball_paths import first_episodes_with_paths, for_path_metrics
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
+from roto.rl.build import check_policy_fits
 from roto.rl.networks import ActorCritic
 from roto.rl.settings import TrainSettings
 from roto.rl.torch_threads import single_torch_thread
@@ -37,6 +38,7 @@ def evaluate(
     for batch in range(math.ceil(episodes / MAX_PARALLEL_ENVS)):
         n = min(MAX_PARALLEL_ENVS, episodes - batch * MAX_PARALLEL_ENVS)
         env = env_factory(for_path_metrics(settings.cpu_env_config(num_envs=n, seed=seed + batch)))
+        check_policy_fits(model, env)
         obs, _ = env.reset(seed=seed + batch)
         with single_torch_thread(env.device):
             result = first_episodes_with_paths(env, model.act_deterministic, obs)

@@ -95,3 +95,21 @@ def build_learner(
 def stacked_sizes(env: object) -> dict[str, int]:
     """{group: stacked size} of every group ``env`` returns (frame size times the frame stack)."""
     return {group: size * env.config.frame_stack for group, size in env.frame_sizes.items()}
+
+
+def check_policy_fits(model: ActorCritic, env: object) -> None:
+    """Refuse to run ``model`` on ``env`` when the groups it reads or its actions have other sizes
+    (a checkpoint whose task, hand or obs mode labels were changed, or belong to other weights).
+
+    Raises:
+        ValueError naming both sets of sizes and the env's task, robot and obs mode.
+    """
+    sizes = stacked_sizes(env)
+    given = {group: sizes.get(group) for group in model.actor_sizes}
+    if given != model.actor_sizes or env.num_actions != model.num_actions:
+        config = env.config
+        raise ValueError(
+            f"the checkpoint's policy reads {model.actor_sizes} and acts on {model.num_actions} joints, but "
+            f"{config.task} on {config.robot} ({config.obs_mode}), which the checkpoint names, gives {given} and "
+            f"{env.num_actions}: its labels do not belong to its weights"
+        )

@@ -100,6 +100,8 @@ class ActorCritic(nn.Module):
         obs_normalization: bool = True,
     ) -> None:
         super().__init__()
+        self.num_actions = int(num_actions)
+        self.actor_sizes = {group: int(sizes[group]) for group in actor_groups}
         self.actor_input = GroupInput(actor_groups, sizes, obs_normalization)
         self.encoder = mlp([self.actor_input.width, *encoder])
         self.latent_width = encoder[-1] if encoder else self.actor_input.width

@@ -3,7 +3,8 @@
 ``<run_dir>/config.yaml`` (``roto.rl.settings``), ``scalars.csv``, ``evaluations.jsonl``,
 ``tensorboard/`` and ``checkpoints/``: ``latest.pt`` (everything a resume needs), ``best.pt`` and
 the numbered copies ``agent_<update>.pt`` (the policy only, ``POLICY_KEYS``). ``load_policy``
-reads any of them without building an env; ``RunDir`` gathers the readers of one run.
+reads any of them without building an env (checking its labels against its run's ``config.yaml``);
+``RunDir`` gathers the readers of one run.
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSetti
     settings = TrainSettings.from_dict(state["train"])
     agent = from_dict(AgentConfig, state["agent"]).validate()
     obs_mode = settings.env.obs_mode
+    _check_run_labels(pathlib.Path(checkpoint), settings)
     if "obs_sizes" in state:
         sizes, num_actions = {k: int(v) for k, v in state["obs_sizes"].items()}, int(state["num_actions"])
     else:  # written before checkpoints carried their sizes: an env tells them
@@ -65,6 +67,24 @@ def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSetti
     model.load_state_dict(state["model"])
     model.eval()
     return model, settings, agent
+
+
+def _check_run_labels(checkpoint: pathlib.Path, settings: TrainSettings) -> None:
+    """Refuse a checkpoint inside a run directory whose task, robot or obs mode differ from the
+    run's own ``config.yaml`` (a checkpoint relabelled, or copied into another run)."""
+    config = checkpoint.parent.parent / "config.yaml"
+    if checkpoint.parent.name != CHECKPOINT_DIR or not config.is_file():
+        return
+    run = read_run_config(checkpoint.parent.parent)[0].env
+    keys = ("task", "robot", "obs_mode")
+    differ = {
+        k: (getattr(settings.env, k), getattr(run, k)) for k in keys if getattr(settings.env, k) != getattr(run, k)
+    }
+    if differ:
+        raise ValueError(
+            f"checkpoint {str(checkpoint)!r} names {differ} (checkpoint, run), unlike its run's {str(config)!r}: "
+            "it was relabelled or copied from another run"
+        )
 
 
 def read_scalars(run_dir: str | pathlib.Path) -> dict[str, tuple[list[int], list[float]]]:
