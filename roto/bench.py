@@ -52,6 +52,14 @@ def raw_physics_steps_per_s(env: Any, states: np.ndarray, ctrls: np.ndarray, sub
     return len(states) * substeps / raw_physics_seconds(env, states, ctrls, substeps)
 
 
+def _check_step_counts(steps: int, warmup: int) -> None:
+    """Refuse step counts the benchmark cannot time: ``steps`` below 1, ``warmup`` below 0."""
+    if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
+        raise ValueError(f"steps (--steps, the timed control steps) must be an integer >= 1, got {steps!r}")
+    if isinstance(warmup, bool) or not isinstance(warmup, int) or warmup < 0:
+        raise ValueError(f"warmup must be an integer >= 0, got {warmup!r}")
+
+
 def run_bench(
     task: str = "bounce",
     robot: str = "shadow",
@@ -65,7 +73,9 @@ def run_bench(
     device: str = "cpu",
     touch: str = "binary",
 ) -> dict[str, Any]:
-    """Measure env and raw physics throughput in one run; returns the JSON-able result."""
+    """Measure env and raw physics throughput in one run; returns the JSON-able result. Refuses
+    ``steps`` below 1 and ``warmup`` below 0 (ValueError) before any env is built."""
+    _check_step_counts(steps, warmup)
     torch.set_num_threads(1)
     env = make(
         task,

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 from roto.cli_args import add_env_args, add_touch_arg
 from roto.cli_demo import add_demo_parser
-from roto.cli_errors import check_output_file, error_exit
+from roto.cli_errors import check_output_path, error_exit, make_parents, quiet_on_closed_stdout
 from roto.olympiad.command import add_olympiad_parsers
 from roto.rl.config_help import HelpConfigAction
 from roto.rl.stop_requests import interrupt_on_sigterm
@@ -119,12 +119,11 @@ def _cmd_eval(args: argparse.Namespace) -> int:
     from roto.rl.run_dir import load_policy
 
     out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
-    if not out.parent.is_dir():  # before the evaluation, which would be lost
-        raise FileNotFoundError(f"--out: directory {str(out.parent)!r} does not exist")
+    check_output_path(out, "--out", example="eval.json")  # before the evaluation, which would be lost
     model, settings, _ = load_policy(args.checkpoint)
     result = evaluate(model, settings, episodes=args.episodes, seed=args.seed)
     result = {"checkpoint": str(args.checkpoint), "task": settings.env.task, "robot": settings.env.robot, **result}
-    write_text_atomic(out, json.dumps(result, indent=1))
+    write_text_atomic(make_parents(out), json.dumps(result, indent=1))
     print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))
     print(f"wrote {out}", file=sys.stderr)
     return 0
@@ -134,7 +133,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
     from roto.eval.video import record_video
     from roto.rl.run_dir import load_policy
 
-    check_output_file(args.video, "--video")
+    check_output_path(args.video, "--video", example="play.mp4")  # missing folders are made when it is written
     model, settings, _ = load_policy(args.checkpoint)
     result = record_video(model, settings, args.video, steps=args.video_length, seed=args.seed)
     print(json.dumps({"video": str(args.video), **result}))
@@ -144,6 +143,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
 def _cmd_render(args: argparse.Namespace) -> int:
     from roto.eval.video import render_scene
 
+    check_output_path(args.out, "--out", example="scene.png")  # missing folders are made when it is written
     path = render_scene(
         args.task, args.robot, args.out, settle_steps=args.settle_steps, seed=args.seed, touch=args.touch
     )
@@ -210,14 +210,18 @@ def _add_eval_parser(sub: argparse._SubParsersAction) -> None:
     p_eval.add_argument("--checkpoint", required=True)
     p_eval.add_argument("--episodes", type=int, default=100)
     p_eval.add_argument("--seed", type=int, default=1_000_000)
-    p_eval.add_argument("--out", default=None, help="JSON path (default: next to the checkpoint)")
+    p_eval.add_argument(
+        "--out", default=None, help="JSON path (default: next to the checkpoint; missing folders are created)"
+    )
     p_eval.set_defaults(func=_cmd_eval)
 
 
 def _add_play_parser(sub: argparse._SubParsersAction) -> None:
     p_play = sub.add_parser("play", help="render a checkpoint's policy offscreen into an mp4")
     p_play.add_argument("--checkpoint", required=True)
-    p_play.add_argument("--video", default="videos/play.mp4", help="mp4 path (default: videos/play.mp4)")
+    p_play.add_argument(
+        "--video", default="videos/play.mp4", help="mp4 path (default: videos/play.mp4; missing folders are created)"
+    )
     p_play.add_argument("--video_length", "--video-length", dest="video_length", type=int, default=600)
     p_play.add_argument("--seed", type=int, default=0)
     p_play.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; always headless")
@@ -228,7 +232,9 @@ def _add_render_parser(sub: argparse._SubParsersAction) -> None:
     p_render = sub.add_parser("render", help="a PNG of a hand in a task scene (offscreen, no display needed)")
     p_render.add_argument("--task", default="bounce")
     p_render.add_argument("--robot", default="shadow")
-    p_render.add_argument("--out", default="scene.png")
+    p_render.add_argument(
+        "--out", default="scene.png", help="PNG or JPEG path (default: scene.png; missing folders are created)"
+    )
     add_touch_arg(p_render)
     p_render.add_argument("--settle_steps", "--settle-steps", dest="settle_steps", type=int, default=60)
     p_render.add_argument("--seed", type=int, default=0)
@@ -274,7 +280,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``roto`` command."""
+    """Entry point of the ``roto`` command; a closed stdout (``roto ... | head -1``) ends it quietly."""
+    with quiet_on_closed_stdout():
+        return _run(argv)
+
+
+def _run(argv: Sequence[str] | None) -> int:
+    """Parse ``argv`` and run its command inside the error boundary (``roto.cli_errors``)."""
     args = build_parser().parse_args(argv)
     interrupt_on_sigterm()
     try:
@@ -284,6 +296,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         print(f"roto {args.command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # stdout's reader went away: for quiet_on_closed_stdout, not an error to print
+        raise
     except Exception as error:
         if args.debug:
             raise

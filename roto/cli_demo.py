@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import pathlib
+import sys
 
 from roto.cli_args import add_env_args
+from roto.cli_errors import check_output_path, parents_made
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
@@ -34,8 +38,6 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _demo_baoding(args: argparse.Namespace) -> int:
-    import pathlib
-
     from roto.reference.baoding_controller import PRESWAP_LEAD, run_reference_baoding
     from roto.reference.baoding_cost import BaodingCostWeights
 
@@ -45,21 +47,34 @@ def _demo_baoding(args: argparse.Namespace) -> int:
         raise ValueError(f"backend {args.backend!r}: the Baoding reference controller plans on 'cpu' only")
     if args.turn_weight is not None and not args.turn_weight >= 0:
         raise ValueError(f"--turn_weight {args.turn_weight}: must be a weight >= 0 (0: off, no direction)")
-    out = pathlib.Path(args.preswap_out) if args.preswap_out else None
-    if out is not None and not out.parent.is_dir():
-        raise FileNotFoundError(f"--preswap_out: directory {str(out.parent)!r} does not exist")
-    stats = run_reference_baoding(
-        robot=args.robot,
-        episodes=args.episodes,
-        seed=args.seed,
-        threads=args.threads,
-        preswap_path=out,
-        preswap_leads=tuple(args.preswap_leads or (PRESWAP_LEAD,)),
-        progress=True,
-        weights=BaodingCostWeights(turn=args.turn_weight or 0.0),
-    )
+    out = preswap_file(args.preswap_out) if args.preswap_out else None  # before the episodes, which take minutes
+    with parents_made(out) if out is not None else contextlib.nullcontext():
+        stats = run_reference_baoding(
+            robot=args.robot,
+            episodes=args.episodes,
+            seed=args.seed,
+            threads=args.threads,
+            preswap_path=out,
+            preswap_leads=tuple(args.preswap_leads or (PRESWAP_LEAD,)),
+            progress=True,
+            weights=BaodingCostWeights(turn=args.turn_weight or 0.0),
+        )
     print(json.dumps(stats))
+    if out is not None:
+        print(f"wrote {out}", file=sys.stderr)
     return 0
+
+
+def preswap_file(path: str) -> pathlib.Path:
+    """The ``.npz`` that ``--preswap_out PATH`` writes: PATH, with ``.npz`` appended when it lacks it (as
+    NumPy appends it); refused, before any episode, when PATH or that file is a directory or cannot be
+    written (``check_output_path``)."""
+    check_output_path(path, "--preswap_out", example="preswap.npz")
+    out = pathlib.Path(path)
+    if out.suffix != ".npz":
+        out = out.with_name(out.name + ".npz")
+        check_output_path(out, f"--preswap_out {path!r} (.npz appended):", example="preswap.npz")
+    return out
 
 
 def add_demo_parser(sub: argparse._SubParsersAction) -> None:
@@ -79,7 +94,8 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> None:
         "--preswap-out",
         dest="preswap_out",
         default=None,
-        help="Baoding: write the states recorded just before each swap to this .npz",
+        help="Baoding: write the states recorded just before each swap to this .npz file (.npz is appended "
+        "to a name without it; missing folders are created; checked before the first episode)",
     )
     p_demo.add_argument(
         "--preswap_leads",

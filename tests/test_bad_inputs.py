@@ -71,6 +71,41 @@ CASES = {
         "nosuch",
     ),
     "zero workers": (lambda d: ["olympiad", "cpu", "--root", str(d / "o"), "--workers", "0"], 2, "--workers"),
+    "pre-swap states at a directory": (
+        lambda d: ["demo", "--task", "baoding", "--preswap_out", str(d)],
+        2,
+        "is a directory; give a file path",
+    ),
+    "pre-swap states under a file": (
+        lambda d: ["demo", "--task", "baoding", "--preswap_out", write(d / "file", "") + "/s.npz"],
+        2,
+        "is not a directory (it is a file)",
+    ),
+    "pre-swap states whose name with .npz is a directory": (
+        lambda d: ["demo", "--task", "baoding", "--preswap_out", write(d / "s.npz" / "f", "").removesuffix(".npz/f")],
+        2,
+        "(.npz appended): ",
+    ),
+    "pre-swap states into new folders, unknown hand": (  # the folders made for the file are removed again
+        lambda d: ["demo", "--task", "baoding", "--robot", "nosuch", "--preswap_out", str(d / "new" / "deeper" / "s")],
+        2,
+        "unknown robot 'nosuch'",
+    ),
+    "image at a directory": (lambda d: ["render", "--out", str(d)], 2, "is a directory; give a file path"),
+    "image under a file": (
+        lambda d: ["render", "--out", write(d / "file", "") + "/scene.png"],
+        2,
+        "is not a directory (it is a file)",
+    ),
+    "image of an unknown format": (lambda d: ["render", "--out", str(d / "scene.xyz")], 2, "['.png', '.jpg'"),
+    "evaluation at a directory": (lambda d: ["eval", "--checkpoint", "x.pt", "--out", str(d)], 2, "is a directory"),
+    "evaluation under a file": (
+        lambda d: ["eval", "--checkpoint", "x.pt", "--out", write(d / "file", "") + "/e.json"],
+        2,
+        "is not a directory (it is a file)",
+    ),
+    "zero timed bench steps": (lambda d: ["bench", "--num_envs", "2", "--steps", "0"], 2, "--steps"),
+    "negative timed bench steps": (lambda d: ["bench", "--num_envs", "2", "--steps", "-3"], 2, "got -3"),
 }
 
 

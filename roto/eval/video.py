@@ -13,8 +13,10 @@ import mujoco
 import numpy as np
 import torch
 
+from roto.cli_errors import check_output_path, make_parents
 from roto.envs.observations import FORCE_SCALE, tactile_frame
 from roto.envs.roto_env import RotoEnv
+from roto.rl.build import check_policy_fits
 from roto.rl.networks import ActorCritic
 from roto.rl.settings import TrainSettings
 from roto.sim.scene import TAXEL_SITE_GROUP
@@ -29,6 +31,8 @@ HARD_TOUCH_VALUE = float(np.log1p(10.0 / FORCE_SCALE))
 """The force touch value (10 N) drawn fully in ``HARD_TOUCH_RGBA``."""
 FPS = 60
 """One frame per control step (60 Hz), so the video plays in real time."""
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+"""The picture formats ``render_scene`` writes."""
 
 
 def _camera() -> mujoco.MjvCamera:
@@ -142,13 +146,14 @@ def record_video(
 
     if steps < 1:
         raise ValueError(f"video length must be >= 1 step, got {steps}")
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    path = check_output_path(path, "video path", example="play.mp4")
     env = RotoEnv(settings.cpu_env_config(num_envs=1, seed=seed))
+    check_policy_fits(model, env)
     renderer = TactileFrameRenderer(env, width, height)
     obs_dict, _ = env.reset(seed=seed)
     frames = 0
     finished: list[dict[str, float]] = []
+    make_parents(path)  # the folders of a new path, now that the env is built
     writer = imageio.get_writer(str(path), format="FFMPEG", fps=FPS, codec="libx264", quality=7, macro_block_size=8)
     try:
         for _ in range(steps):
@@ -184,8 +189,9 @@ def render_scene(
 
     from roto.envs.config import EnvConfig
 
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    path = check_output_path(path, "image path", example="scene.png")
+    if path.suffix.lower() not in IMAGE_SUFFIXES:
+        raise ValueError(f"image path {str(path)!r}: give a file ending in one of {list(IMAGE_SUFFIXES)}")
     env = RotoEnv(EnvConfig(task=task, robot=robot, num_envs=1, seed=seed, reset_joint_noise=0.0, touch=touch))
     env.reset(seed=seed)
     hold = env.hold_action()
@@ -193,7 +199,7 @@ def render_scene(
         env.step(hold)
     renderer = TactileFrameRenderer(env, width, height)
     try:
-        imageio.imwrite(path, renderer.render())
+        imageio.imwrite(make_parents(path), renderer.render())
     finally:
         renderer.close()
         env.close()
