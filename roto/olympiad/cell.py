@@ -19,6 +19,7 @@ import subprocess
 from collections.abc import Callable
 from typing import Any
 
+import roto
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
 from roto.eval.evaluate import evaluate
@@ -34,9 +35,20 @@ from roto.tasks import get_task
 
 
 def code_commit() -> str:
-    """The checked-out commit (short hash), or "unknown" outside a git checkout."""
-    out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=False)
-    return out.stdout.strip() or "unknown"
+    """The commit (short hash) of the roto code that runs: that of the git checkout holding the ``roto``
+    package, whatever the current directory; "unknown" when the package is not a tracked part of a git
+    checkout (an installed copy, even one inside another project's checkout) or git is missing."""
+    package = pathlib.Path(roto.__file__).resolve().parent
+
+    def git(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run(["git", "-C", str(package), *args], capture_output=True, text=True, check=False)
+
+    try:
+        tracked = git("ls-files", "--error-unmatch", "__init__.py").returncode == 0
+        out = git("rev-parse", "--short", "HEAD") if tracked else None
+    except OSError:  # no git on this machine
+        return "unknown"
+    return out.stdout.strip() if out is not None and out.returncode == 0 and out.stdout.strip() else "unknown"
 
 
 TRAINING_SCALARS = ("ppo/action_std",)  # besides every ``train/...`` scalar (the training episodes')

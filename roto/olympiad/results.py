@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from roto.cli_errors import check_output_path
 from roto.eval.plots import plot_variants
 from roto.olympiad.plan import load_plan
 from roto.olympiad.stats import iqm, probability_of_improvement, stratified_bootstrap_ci
@@ -62,11 +63,66 @@ def variant_agents(summaries: list[dict], plan: str = "") -> Agents:
 
 
 def read_summaries(folder: str | pathlib.Path) -> list[dict]:
-    """Every cell summary (``<cell>.json``) in ``folder``."""
+    """Every cell summary (``<cell>.json``) in ``folder``, each checked (``check_summary``)."""
     paths = sorted(pathlib.Path(folder).glob("*-seed*.json"))
     if not paths:
         raise FileNotFoundError(f"no cell summaries (<task>-<robot>-<obs>-<variant>-seed<k>.json) in {str(folder)!r}")
-    return [read_json(path, "cell summary") for path in paths]
+    return [check_summary(path, read_json(path, "cell summary")) for path in paths]
+
+
+SUMMARY_FIELDS = {
+    "task": str,
+    "robot": str,
+    "obs": str,
+    "variant": str,
+    "seed": int,
+    "plan": str,
+    "commit": str,
+    "evaluations": list,
+    "final": dict,
+    "best": dict,
+}
+"""The fields ``roto results`` reads from every cell summary, with their JSON types."""
+JSON_TYPES = {str: "a string", int: "an integer", list: "an array", dict: "an object"}
+RECORD_FIELDS = ("env_steps", "train_wall_s")
+"""The numbers every evaluation record of a summary holds besides its task metric's mean."""
+
+
+def json_kind(value: Any) -> str:
+    """What a JSON value is, in JSON's words: an object, an array of 3 items, a string ('x'), null, ..."""
+    if isinstance(value, list):
+        return f"an array of {len(value)} items"
+    kinds = ((dict, "an object"), (str, "a string"), (bool, "a boolean"), (int, "an integer"), (float, "a number"))
+    return next((f"{name} ({value!r:.40})" for kind, name in kinds if isinstance(value, kind)), "null")
+
+
+def check_summary(path: str | pathlib.Path, summary: Any) -> dict:
+    """``summary``, read from ``path``, if it has what ``roto results`` reads (``SUMMARY_FIELDS``, and
+    the task metric's mean in its final, best and evaluation records); else a ValueError naming the
+    file, what was expected and what was found."""
+    where = f"cell summary {str(path)!r}"
+    if not isinstance(summary, dict):
+        raise ValueError(f"{where} holds {json_kind(summary)}, not an object (a cell summary of roto olympiad)")
+    missing = [key for key in SUMMARY_FIELDS if key not in summary]
+    if missing:
+        raise ValueError(f"{where} lacks the field(s) {missing}; a cell summary has {list(SUMMARY_FIELDS)}")
+    for key, kind in SUMMARY_FIELDS.items():
+        if not isinstance(summary[key], kind) or isinstance(summary[key], bool):
+            raise ValueError(f"{where}: {key!r} should be {JSON_TYPES[kind]}, found {json_kind(summary[key])}")
+    try:
+        mean = f"{metric(summary['task'])}_mean"
+    except ValueError as error:  # an unknown task, named with the valid ones
+        raise ValueError(f"{where}: {error}") from None
+    records = [("final", summary["final"], (mean,)), ("best", summary["best"], (mean,))]
+    records += [(f"evaluations[{i}]", r, (*RECORD_FIELDS, mean)) for i, r in enumerate(summary["evaluations"])]
+    for part, record, keys in records:
+        if not isinstance(record, dict):
+            raise ValueError(f"{where}: {part} should be an object, found {json_kind(record)}")
+        for key in keys:
+            if isinstance(record.get(key), bool) or not isinstance(record.get(key), (int, float)):
+                found = json_kind(record[key]) if key in record else "no such field"
+                raise ValueError(f"{where}: {part} should hold the number {key!r}, found {found}")
+    return summary
 
 
 def scores_by_cell(summaries: Iterable[dict], policy: str = "final") -> dict[Key, np.ndarray]:
@@ -234,9 +290,10 @@ def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pa
 
 
 def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str = "") -> dict[str, str]:
-    """results.md, results.csv and curve PNGs in ``out`` from the summaries in ``source``."""
+    """results.md, results.csv and curve PNGs in ``out`` (``--out``: a folder, made with its missing
+    parents; refused, before anything is written, where it cannot be one) from the summaries in ``source``."""
     summaries = read_summaries(source)
-    out = pathlib.Path(out)
+    out = check_output_path(out, "--out", kind="dir")
     out.mkdir(parents=True, exist_ok=True)
     commits = sorted({s["commit"] for s in summaries})
     label = f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
