@@ -44,3 +44,31 @@ def test_files_that_are_not_roto_checkpoints_are_clear_errors(tmp_path):
         load_checkpoint(tmp_path / "other.pt")
     with pytest.raises(FileNotFoundError, match="does not exist"):
         load_checkpoint(tmp_path / "missing.pt")
+
+
+def broken_copies(tmp_path):
+    """{case: (path, words)}: a good checkpoint truncated, with bytes zeroed, holding an object,
+    and a directory."""
+    save_checkpoint({"model": {"w": torch.ones(4096)}, "train": {}, "agent": {}}, tmp_path / "good.pt")
+    data = (tmp_path / "good.pt").read_bytes()
+    (tmp_path / "half.pt").write_bytes(data[: len(data) // 2])
+    zeroed = bytearray(data)
+    zeroed[64:160] = bytes(96)
+    (tmp_path / "zeroed.pt").write_bytes(bytes(zeroed))
+    torch.save({"model": {}, "train": {}, "agent": {}, "x": RunsCode()}, tmp_path / "object.pt")
+    (tmp_path / "folder.pt").mkdir()
+    return {
+        "truncated": (tmp_path / "half.pt", "is truncated or corrupted"),
+        "zeroed bytes": (tmp_path / "zeroed.pt", "is not a roto checkpoint"),
+        "an object": (tmp_path / "object.pt", "holds pickled objects beyond tensors, numbers and strings"),
+        "a directory": (tmp_path / "folder.pt", "is a directory; give a .pt file in it"),
+    }
+
+
+def test_a_broken_checkpoint_is_one_line_naming_it_and_never_advises_unsafe_loading(tmp_path):
+    for path, words in broken_copies(tmp_path).values():
+        with pytest.raises((ValueError, IsADirectoryError)) as refused:
+            load_checkpoint(path)
+        message = str(refused.value)
+        assert words in message and str(path) in message and "\n" not in message
+        assert "weights_only" not in message and "trust" not in message and "unsafe" not in message.lower()
