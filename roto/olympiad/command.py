@@ -49,8 +49,9 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     from roto.olympiad.plan import load_plan
     from roto.olympiad.worker import enqueue_missing, open_olympiad, run_olympiad_worker
     from roto.sweep.claims import launch_workers
-    from roto.sweep.storage import reclaim_now
+    from roto.sweep.storage import reclaim_now, resolve_storage, storage_in_environment
 
+    args.storage = resolve_storage(args.storage)
     plan = load_plan(args.plan)  # checked before anything runs or is written
     if args.threads is not None:
         if args.threads < 1:
@@ -72,8 +73,8 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         enqueue_missing(study, plan, results)
         argv = [args.plan, "--root", args.root, "--results", str(results), "--heartbeat", str(args.heartbeat),
                 "--torch_threads", str(args.torch_threads), "--threads", str(plan.threads)]  # fmt: skip
-        argv += ["--storage", args.storage] if args.storage else []
-        return launch_workers("olympiad", args.workers, argv)
+        with storage_in_environment(args.storage) as storage_argv:  # never on argv: /proc/PID/cmdline is public
+            return launch_workers("olympiad", args.workers, argv + storage_argv)
     torch.set_num_threads(args.torch_threads)
     finished = run_olympiad_worker(plan, args.root, results, args.storage, args.heartbeat, reclaim=args.reclaim_now)
     print(json.dumps({"plan": plan.name, "finished_by_this_worker": finished, "results": str(results)}))

@@ -6,7 +6,11 @@ import argparse
 import json
 import sys
 
-STORAGE_HELP = "database URL (postgresql://...) or a journal file's path (*.log); default: <root>/<study>/journal.log"
+STORAGE_HELP = (
+    "database URL (postgresql://...) or a journal file's path (*.log); default: <root>/<study>/journal.log. "
+    "env:NAME reads it from environment variable NAME (as the workers --workers starts do, so that no "
+    "password shows in their command lines)"
+)
 
 RUN_FLAGS = ("task", "robot", "obs", "agent_cfg", "space", "objective", "trials", "startup", "steps", "warmup_steps",
              "num_envs", "threads", "root", "storage", "heartbeat")  # fmt: skip
@@ -68,10 +72,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     from roto.sweep.claims import launch_workers
     from roto.sweep.space import load_space
-    from roto.sweep.storage import reclaim_now
+    from roto.sweep.storage import reclaim_now, resolve_storage, storage_in_environment
     from roto.sweep.study import SweepSettings, enqueue_base, open_study
     from roto.sweep.worker import run_worker
 
+    args.storage = resolve_storage(args.storage)
     if args.study is None:
         raise ValueError("--study is required: the study's name (workers with the same name join one study)")
     values = {name: getattr(args, name) for name in RUN_FLAGS}
@@ -94,7 +99,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         study, storage = open_study(settings)  # create it once, so the workers only join
         if args.reclaim_now:  # here, once: a worker reclaiming would take its siblings' fresh claims
             reclaim_now(study, storage)
-        return launch_workers("sweep", args.workers, _worker_argv(args))
+        with storage_in_environment(args.storage) as storage_argv:  # never on argv: /proc/PID/cmdline is public
+            return launch_workers("sweep", args.workers, _worker_argv(args) + storage_argv)
     torch.set_num_threads(args.torch_threads)
     finished = run_worker(settings, reclaim=args.reclaim_now)
     print(json.dumps({"study": settings.study, "finished_by_this_worker": finished}))
@@ -102,10 +108,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _worker_argv(args: argparse.Namespace) -> list[str]:
+    """A worker's arguments but ``--storage`` (which reaches it through the environment)."""
     argv = ["--study", args.study, "--torch_threads", str(args.torch_threads)]
     for name in RUN_FLAGS:
         value = getattr(args, name)
-        if value is not None:
+        if value is not None and name != "storage":
             argv += [f"--{name}", str(value)]
     for item in args.overrides:
         argv += ["--set", item]
@@ -115,14 +122,16 @@ def _worker_argv(args: argparse.Namespace) -> list[str]:
 def cmd_export(args: argparse.Namespace) -> int:
     """Write the best trial's agent config."""
     from roto.sweep.report import export_best
+    from roto.sweep.storage import resolve_storage
 
-    print(json.dumps(export_best(args.study, args.root, args.storage, args.out, args.trial)))
+    print(json.dumps(export_best(args.study, args.root, resolve_storage(args.storage), args.out, args.trial)))
     return 0
 
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Print the study's trials and importances."""
     from roto.sweep.report import show
+    from roto.sweep.storage import resolve_storage
 
-    sys.stdout.write(show(args.study, args.root, args.storage) + "\n")
+    sys.stdout.write(show(args.study, args.root, resolve_storage(args.storage)) + "\n")
     return 0

@@ -5,7 +5,8 @@ is retried, with growing pauses, for up to ``window_s`` seconds; a restart of th
 worker a pause, not its trial. Errors that are not about the connection (a bad value, a finished
 trial) are raised at once. Connection errors that outlast the window are raised as
 ``DatabaseUnreachable``, whose message names the URL (password hidden) and the driver's reason
-instead of Optuna's generic one ("invalid data in the commit").
+instead of Optuna's generic one ("invalid data in the commit"); a role without the privileges
+Optuna's tables need gets ``DatabasePermissionDenied``, saying so.
 
 A write the server committed just before the connection dropped may be sent again. A second claim
 or ``tell`` of one trial finds it already running or finished, which a worker treats as a trial
@@ -45,6 +46,41 @@ STORAGE_METHODS = (
 class DatabaseUnreachable(ConnectionError):
     """The database stayed unreachable for the whole retry window (an OSError: the CLI reports it
     in one line, exit code 1)."""
+
+
+class DatabasePermissionDenied(PermissionError):
+    """The database refused the role an operation on Optuna's tables. A PermissionError, so the CLI
+    reports it in one line with exit code 2, as a wrong password: the command cannot succeed until
+    the role's grants or the URL change, and running it again does not help."""
+
+
+INSUFFICIENT_PRIVILEGE = "42501"
+"""The SQLSTATE of PostgreSQL's "permission denied" (psycopg2's ``pgcode``, psycopg 3's ``sqlstate``)."""
+GRANTS_NEEDED = (
+    "the role needs SELECT, INSERT, UPDATE and DELETE on Optuna's tables and USAGE on their sequences "
+    "(in a new database also CREATE on the schema, to make them)"
+)
+
+
+def permission_error(error: BaseException) -> BaseException | None:
+    """The driver's "permission denied" behind ``error`` (Optuna wraps it in StorageInternalError,
+    which hides it behind "invalid data in the commit, e.g. exceeding max length"), or None."""
+    chain, seen = [error], set()
+    while chain:
+        found = chain.pop()
+        if found is None or id(found) in seen:
+            continue
+        seen.add(id(found))
+        codes = (getattr(found, "pgcode", None), getattr(found, "sqlstate", None))
+        if INSUFFICIENT_PRIVILEGE in codes or type(found).__name__ == "InsufficientPrivilege":
+            return found
+        chain += [found.__cause__, found.__context__, getattr(found, "orig", None)]
+    return None
+
+
+def permission_denied(name: str, cause: BaseException) -> DatabasePermissionDenied:
+    """The one-line error for the database named ``name`` (its URL, password hidden) refusing ``cause``."""
+    return DatabasePermissionDenied(f"database {name!r}: {first_line(cause)}: {GRANTS_NEEDED}")
 
 
 def connection_error(error: BaseException) -> BaseException | None:
@@ -90,6 +126,9 @@ class RetryingStorage(optuna.storages.BaseStorage):
             try:
                 return getattr(self.inner, method)(*args, **kwargs)
             except Exception as error:
+                denied = permission_error(error)
+                if denied is not None:
+                    raise permission_denied(self.name, denied) from None
                 cause = connection_error(error)
                 if cause is None:
                     raise

@@ -17,24 +17,28 @@ directory from its latest checkpoint. This works the same on the journal and on 
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import math
+import os
 import pathlib
+import re
 import sys
 import threading
 import time
 import urllib.parse
 import warnings
+from collections.abc import Iterator
 
 import optuna
 import sqlalchemy.exc
-from optuna.exceptions import UpdateFinishedTrialError
+from optuna.exceptions import StorageInternalError, UpdateFinishedTrialError
 from optuna.storages import RetryHeartbeatStaleTrialCallback
 from optuna.storages.journal import JournalStorage
 from optuna.trial import TrialState
 
 from roto.sweep.journal import JournalFile
-from roto.sweep.retrying_storage import RetryingStorage, first_line
+from roto.sweep.retrying_storage import RetryingStorage, first_line, permission_denied, permission_error
 
 JOURNAL_NAME = "journal.log"
 HEARTBEAT_ATTR = "roto:heartbeat"
@@ -51,13 +55,125 @@ with warnings.catch_warnings():  # Optuna marks the callback experimental; roto 
 ``RETRY_OF_ATTR`` naming the first try."""
 
 
+SECRET_PARAMETER = re.compile(r"(?:^|[?&;\s])([^?&;=\s]*)=")
+"""A ``key=`` of a URL's query string (or of a libpq ``key=value`` string); a key naming a
+password (``password``, ``sslpassword``, any case, percent-encoded or not) starts a secret."""
+SCHEME = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*://")
+STORAGE_ENV = "ROTO_STORAGE_URL"
+"""The environment variable that carries ``--storage`` to the workers a command starts (never their
+argv, which any local user can read in /proc/PID/cmdline)."""
+ENV_PREFIX = "env:"
+"""``--storage env:NAME``: the storage is the value of the environment variable ``NAME``."""
+
+
+def _after_scheme(url: str) -> int:
+    """Where the text after ``scheme://`` begins (0 when ``url`` does not begin with one)."""
+    found = SCHEME.match(url)
+    return found.end() if found else 0
+
+
+def password_span(url: str) -> tuple[int, int] | None:
+    """Where the password of ``user:password@host`` lies in ``url``: from the first ``:`` after the
+    scheme to the last ``@`` (a password may hold ``@ : / # ?``); None without one. Without an
+    ``@``, a ``:`` followed by no port (``user:password``, the host left out) starts one that runs
+    to the end."""
+    start, at = _after_scheme(url), url.rfind("@")
+    if at >= start:
+        colon = url.find(":", start, at)
+        return (colon + 1, at) if colon >= 0 else None
+    authority = re.match(r"[^/?#]*", url[start:]).group()
+    colon = authority.find(":")
+    port = authority[colon + 1 :]
+    if colon < 0 or authority.startswith("[") or not port or port.isdigit():
+        return None
+    return start + colon + 1, len(url)
+
+
+def secret_parameter(url: str) -> tuple[int, int] | None:
+    """(where its key begins, where its value begins) of the first ``password=`` parameter of
+    ``url``; None without one."""
+    for match in SECRET_PARAMETER.finditer(url, _after_scheme(url)):
+        if "password" in urllib.parse.unquote_plus(match.group(1)).lower():
+            return match.start(1), match.end()
+    return None
+
+
+def secret_regions(url: str) -> tuple[tuple[int, int] | None, int | None]:
+    """(the userinfo password's ``password_span``, where a ``password=`` parameter's value begins)
+    in ``url``, either None when absent. A span that begins inside the parameter's value is part of
+    it: the span is then None."""
+    span, parameter = password_span(url), secret_parameter(url)
+    if parameter is not None and span is not None and parameter[0] < span[0]:
+        span = None
+    return span, None if parameter is None else parameter[1]
+
+
 def redact_url(url: str) -> str:
-    """``url`` with its password replaced by ``***`` (for messages and logs)."""
-    parts = urllib.parse.urlsplit(url)
-    if parts.password is None:
-        return url
-    netloc = parts.netloc.replace(f":{parts.password}@", ":***@", 1)
-    return urllib.parse.urlunsplit(parts._replace(netloc=netloc))
+    """``url`` with its passwords replaced by ``***`` (for messages and logs).
+
+    Found by hand, not by ``urllib`` (which ends a password at ``/``, ``#`` or ``?``): the
+    userinfo's password (``password_span``) and everything after a ``password=`` parameter. A
+    malformed URL is hidden the same way; at worst more than the password is hidden, never less.
+    """
+    span, value = secret_regions(url)
+    if span is None:
+        return url if value is None else f"{url[:value]}***"
+    if value is not None and value <= span[1]:  # "password=" inside the userinfo: it may be either
+        return f"{url[: span[0]]}***"
+    end = len(url) if value is None else value
+    return f"{url[: span[0]]}***{url[span[1] : end]}" + ("" if value is None else "***")
+
+
+def url_secrets(url: str) -> list[str]:
+    """The passwords in ``url`` as given and percent-decoded, longest first (to scrub them from a
+    driver's messages)."""
+    span, value = secret_regions(url)
+    found = [url[span[0] : span[1]]] if span else []
+    if value is not None:
+        found.append(re.split(r"[&;\s]", url[value:])[0])
+    found += [urllib.parse.unquote_plus(text) for text in found] + [urllib.parse.unquote(text) for text in found]
+    return sorted({text for text in found if text}, key=len, reverse=True)
+
+
+def scrub(text: str, url: str) -> str:
+    """``text`` with each password of ``url`` replaced by ``***``."""
+    for secret in url_secrets(url):
+        text = text.replace(secret, "***")
+    return text
+
+
+def resolve_storage(value: str | None) -> str | None:
+    """``--storage``'s value: ``env:NAME`` becomes the value of environment variable ``NAME``
+    (how the workers a command starts get it, ``storage_in_environment``); anything else as given.
+
+    Raises:
+        ValueError when the variable is not set.
+    """
+    if value is None or not value.startswith(ENV_PREFIX):
+        return value
+    name = value[len(ENV_PREFIX) :]
+    url = os.environ.get(name)
+    if not url:
+        raise ValueError(f"--storage {value}: the environment variable {name!r} is not set (or is empty)")
+    return url
+
+
+@contextlib.contextmanager
+def storage_in_environment(url: str | None) -> Iterator[list[str]]:
+    """While inside, ``url`` is in this process's environment as ``STORAGE_ENV``, so worker processes
+    started here inherit it; yields the worker's ``--storage`` arguments (none without ``url``)."""
+    if url is None:
+        yield []
+        return
+    before = os.environ.get(STORAGE_ENV)
+    os.environ[STORAGE_ENV] = url
+    try:
+        yield ["--storage", ENV_PREFIX + STORAGE_ENV]
+    finally:
+        if before is None:
+            os.environ.pop(STORAGE_ENV, None)
+        else:
+            os.environ[STORAGE_ENV] = before
 
 
 CONNECT_TIMEOUT_S = 10
@@ -84,8 +200,8 @@ def journal_path(url: str) -> pathlib.Path | None:
         return None
     if not url.endswith(".log"):
         raise ValueError(
-            f"storage {url!r} is neither a database URL (e.g. postgresql://user@host/db, sqlite:///file.db) "
-            f"nor a journal file's path (ending in .log)"
+            f"storage {redact_url(url)!r} is neither a database URL (e.g. postgresql://user@host/db, "
+            "sqlite:///file.db) nor a journal file's path (ending in .log)"
         )
     return pathlib.Path(url)
 
@@ -106,21 +222,51 @@ def open_storage(study_dir: pathlib.Path, url: str | None = None) -> optuna.stor
     Raises:
         ValueError naming the URL (password hidden) when the database cannot be reached in
         ``CONNECT_TIMEOUT_S`` or refuses the connection, or when ``url`` is neither a URL nor a
-        ``*.log`` path.
+        ``*.log`` path; ``DatabasePermissionDenied`` when the role may not use Optuna's tables.
     """
     journal = journal_of(study_dir, url)
     if journal is not None:
         journal.parent.mkdir(parents=True, exist_ok=True)
         return JournalStorage(JournalFile(str(journal)))
     driver_url = database_url(url)
+    check_url_parses(url, driver_url)
     engine = {"pool_pre_ping": True}  # a connection the server dropped is replaced, not used
     if driver_url.startswith("postgresql"):
         engine["connect_args"] = {"connect_timeout": CONNECT_TIMEOUT_S}
+    template = driver_url.replace("{", "{{").replace("}", "}}")  # Optuna fills {SCHEMA_VERSION} with str.format
     try:
-        database = optuna.storages.RDBStorage(driver_url, engine_kwargs=engine)
-    except sqlalchemy.exc.SQLAlchemyError as error:
-        raise ValueError(f"cannot open the storage {redact_url(url)!r}: {first_line(error)}") from None
+        database = optuna.storages.RDBStorage(template, engine_kwargs=engine)
+    except (sqlalchemy.exc.SQLAlchemyError, StorageInternalError) as error:
+        denied = permission_error(error)
+        if denied is not None:
+            raise permission_denied(redact_url(url), denied) from None
+        driver = (error.__cause__ or error) if isinstance(error, StorageInternalError) else error
+        raise ValueError(f"cannot open the storage {redact_url(url)!r}: {scrub(first_line(driver), url)}") from None
     return RetryingStorage(database, redact_url(url))
+
+
+def check_url_parses(url: str, driver_url: str) -> None:
+    """Refuse a database URL SQLAlchemy cannot parse, or whose password it reads otherwise than
+    ``redact_url`` hides it (an ``@`` in it ends SQLAlchemy's password: the rest would reach the
+    server as the host, and its messages). ``driver_url``: ``url`` with the driver named.
+
+    Raises:
+        ValueError naming the URL with its password hidden.
+    """
+    try:
+        parsed = sqlalchemy.engine.make_url(driver_url)
+    except (sqlalchemy.exc.ArgumentError, ValueError, TypeError):  # e.g. a port that is not a number
+        raise ValueError(
+            f"the storage {redact_url(url)!r} is not a database URL SQLAlchemy can read "
+            "(scheme://user:password@host:port/database; percent-encode @ : / in the user or password)"
+        ) from None
+    span = password_span(url)
+    given = urllib.parse.unquote(url[span[0] : span[1]]) if span else None
+    if parsed.password is not None and parsed.password != given:
+        raise ValueError(
+            f"the storage {redact_url(url)!r} has an '@' in its password, which ends it for SQLAlchemy: "
+            "write it percent-encoded, as %40"
+        )
 
 
 def find_study(folder: pathlib.Path, name: str, url: str | None = None) -> optuna.Study | None:
