@@ -60,6 +60,16 @@ CASES = {
         2,
         "postgresql+psycopg2://u:***@127.0.0.1:1/db",
     ),
+    "database password with / # ?": (
+        lambda d: ["sweep", "show", "--study", "s", "--storage", "postgresql+psycopg2://u:p/a#secret?@127.0.0.1:1/db"],
+        2,
+        "postgresql+psycopg2://u:***@127.0.0.1:1/db",
+    ),
+    "database password as a parameter": (
+        lambda d: ["sweep", "show", "--study", "s", "--storage", "postgresql://u@127.0.0.1:1/db?Password=secret"],
+        2,
+        "postgresql://u@127.0.0.1:1/db?Password=***",
+    ),
     "study name climbing out of the root": (
         lambda d: ["sweep", "--study", "..", "--root", str(d / "sweeps")],
         2,
