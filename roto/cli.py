@@ -8,7 +8,7 @@ import json
 import sys
 from collections.abc import Sequence
 
-from roto.cli_args import add_env_args, add_touch_arg
+from roto.cli_args import add_env_args, add_touch_arg, options_given
 from roto.cli_demo import add_demo_parser
 from roto.cli_errors import check_output_path, error_exit, make_parents, quiet_on_closed_stdout
 from roto.olympiad.command import add_olympiad_parsers
@@ -75,12 +75,9 @@ def _cmd_train(args: argparse.Namespace) -> int:
     torch.set_num_threads(args.torch_threads)
     wandb_project = args.wandb_project if args.logger == "wandb" else None
     if args.resume:
-        if args.overrides:
-            raise ValueError(
-                f"--resume continues a run as it was configured; the overrides {args.overrides} would be ignored: "
-                "drop them, or start a new run with --run_dir"
-            )
-        trainer = Trainer.open(args.resume, steps=args.steps, wandb_project=wandb_project)
+        _refuse_ignored_resume_flags(args)
+        threads = args.threads if "threads" in _train_options_given(args) else None
+        trainer = Trainer.resume(args.resume, args.steps, wandb_project=wandb_project, threads=threads)
     else:
         # the env flags are shorthand for env.* overrides, which win over them; all checked before anything is written
         flags = dict(num_envs=args.num_envs, seed=args.seed, backend=args.backend, device=args.device,
@@ -109,6 +106,32 @@ def _cmd_train(args: argparse.Namespace) -> int:
     summary["settings"] = trainer.settings.to_dict()
     print(json.dumps(summary))
     return 0
+
+
+RESUME_KEEPS = ("resume", "steps", "threads", "torch_threads", "no_progress", "logger", "wandb_project", "headless")
+"""What ``roto train --resume`` takes from the command line: the budget and how to run; the rest is the run's."""
+
+
+def _train_options_given(args: argparse.Namespace) -> set[str]:
+    """The destinations of the ``roto train`` options the command line gave itself."""
+    probe = argparse.ArgumentParser(prog="roto").add_subparsers()
+    _add_train_parser(probe)
+    argv = args.argv[args.argv.index("train") + 1 :]
+    return options_given(probe.choices["train"], argv)
+
+
+def _refuse_ignored_resume_flags(args: argparse.Namespace) -> None:
+    """Refuse, naming them, the flags and overrides that ``--resume`` would ignore."""
+    ignored = sorted(_train_options_given(args) - set(RESUME_KEEPS))
+    if not ignored:
+        return
+    named = [f"--{dest}" for dest in ignored if dest != "overrides"]
+    named += [f"the overrides {args.overrides}"] if "overrides" in ignored else []
+    raise ValueError(
+        f"--resume continues a run as it was configured; {', '.join(named)} would be ignored: drop "
+        f"{'it' if len(named) == 1 else 'them'}, or start a new run with --run_dir (--resume keeps only "
+        "--steps, --threads, --torch_threads, --no_progress, --logger and --wandb_project)"
+    )
 
 
 def _cmd_eval(args: argparse.Namespace) -> int:
@@ -287,7 +310,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _run(argv: Sequence[str] | None) -> int:
     """Parse ``argv`` and run its command inside the error boundary (``roto.cli_errors``)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
     args = build_parser().parse_args(argv)
+    args.argv = argv
     interrupt_on_sigterm()
     try:
         return int(args.func(args))

@@ -26,3 +26,18 @@ def add_touch_arg(parser: argparse.ArgumentParser) -> None:
         "(log(1 + |F| / 0.1 N) of each link's net contact force) or taxels (the link bits, then a bit "
         "per taxel of the fingertip pads and the palm)",
     )
+
+
+class _NotGiven:
+    """The default of every option while ``options_given`` parses: a value no command line makes."""
+
+
+def options_given(parser: argparse.ArgumentParser, argv: list[str]) -> set[str]:
+    """The destinations of the options and positionals that ``argv`` sets itself (not by default).
+
+    ``parser`` must be a fresh parser of its own: its defaults are replaced by a marker, so only
+    what ``argv`` names holds another value."""
+    not_given = _NotGiven()
+    parser.set_defaults(**{dest: not_given for dest in vars(parser.parse_args([]))})
+    given = vars(parser.parse_args(argv))
+    return {dest for dest, value in given.items() if value is not not_given and value != []}

@@ -34,9 +34,8 @@ def test_demo_runs_the_scripted_policy(capsys):
 def test_baoding_demo_refuses_what_the_reference_controller_cannot_do(capsys, tmp_path):
     assert main(["demo", "--task", "baoding", "--backend", "warp"]) == 2
     assert "the Baoding reference controller plans on 'cpu' only" in capsys.readouterr().err
-    missing = tmp_path / "nowhere" / "states.npz"
-    assert main(["demo", "--task", "baoding", "--preswap_out", str(missing)]) == 2
-    assert f"directory {str(missing.parent)!r} does not exist" in capsys.readouterr().err
+    assert main(["demo", "--task", "baoding", "--preswap_out", str(tmp_path)]) == 2
+    assert f"--preswap_out {str(tmp_path)!r} is a directory" in capsys.readouterr().err
     assert main(["demo", "--task", "bounce", "--preswap_out", str(tmp_path / "s.npz")]) == 2
     assert "--preswap_out, --preswap_leads and --turn_weight are for --task baoding" in capsys.readouterr().err
     assert main(["demo", "--task", "bounce", "--turn_weight", "3"]) == 2

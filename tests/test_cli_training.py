@@ -273,10 +273,11 @@ def test_eval_refuses_a_checkpoint_whose_labels_do_not_fit_its_weights(trained_r
     assert "names {'task': ('baoding', 'bounce')} (checkpoint, run), unlike its run's" in err and err.count("\n") == 1
 
 
-def test_eval_into_a_missing_directory_fails_before_evaluating(trained_run, tmp_path, capsys):
-    out = tmp_path / "nowhere" / "eval.json"
+def test_eval_under_a_file_fails_before_evaluating(trained_run, tmp_path, capsys):
+    (tmp_path / "afile").write_text("")
+    out = tmp_path / "afile" / "eval.json"
     assert main(["eval", "--checkpoint", str(trained_run / "checkpoints" / "latest.pt"), "--out", str(out)]) == 2
-    assert f"--out: directory {str(out.parent)!r} does not exist" in capsys.readouterr().err
+    assert f"'{tmp_path / 'afile'}' is not a directory (it is a file)" in capsys.readouterr().err
 
 
 def test_zero_torch_threads_is_a_clear_error(capsys):
