@@ -63,10 +63,6 @@ BANK_BOUND = 1e3
 """The largest magnitude a bank's value may have: recorded positions (m, rad), velocities and
 joint targets of a hand the size of a hand stay far below it; NaN, inf or 1e30 are a broken file."""
 
-BANK_TASK = "baoding"
-"""The task a bank without a ``task`` entry was recorded on (the only task ``roto demo`` records)."""
-
-
 def read_bank(path: str | pathlib.Path) -> dict[str, np.ndarray]:
     """The arrays of the ``.npz`` bank ``path``, read without pickle.
 
@@ -109,10 +105,9 @@ def check_bank(path: str, arrays: dict[str, np.ndarray], task: str, robot: str, 
         ValueError naming the file, what was expected and what was found.
     """
     where = f"replay_starts {path!r}"
-    for name, own in (("task", task), ("robot", robot)):
-        found = str(arrays[name]) if name in arrays else (BANK_TASK if name == "task" else own)
-        if found != own:
-            raise ValueError(f"{where}: states recorded on {name} {found!r}, not this env's {own!r}")
+    for name, own in (("task", task), ("robot", robot)):  # a bank without the entry: its shapes must fit
+        if name in arrays and str(arrays[name]) != own:
+            raise ValueError(f"{where}: states recorded on {name} {str(arrays[name])!r}, not this env's {own!r}")
     physics, target = arrays.get("physics"), arrays.get("target")
     if physics is None or target is None or physics.ndim != 2 or len(physics) == 0:
         raise ValueError(f"{where}: needs non-empty arrays 'physics' (n, nstate) and 'target'")
