@@ -1,9 +1,12 @@
+import json
 import pathlib
 
 import pytest
 
 from roto.olympiad.plan import Cell, load_plan, packaged_plans
 from roto.rl.config import load_agent_config
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def test_packaged_plans():
@@ -90,13 +93,13 @@ def test_cli_rejects_a_bad_plan_before_anything_runs(tmp_path, capsys):
 
 
 def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp_path, capsys):
-    import json
 
     from roto.cli import main
 
     results = tmp_path / "results"
     results.mkdir()
-    done = {"env_steps": 5_000_000, "train_wall_s": 1000.0}  # 5000 env steps/s
+    committed = ROOT / "benchmarks" / "results" / "olympiad_cpu" / "bounce-shadow-blind-ppo-seed0.json"
+    done = {**json.loads(committed.read_text()), "env_steps": 5_000_000, "train_wall_s": 1000.0}  # 5000 env steps/s
     (results / "bounce-shadow-blind-ppo-seed0.json").write_text(json.dumps(done))
     assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
     out = capsys.readouterr().out

@@ -1,7 +1,10 @@
+import pathlib
+
 import pytest
 
 from roto.rl.run_spec import build_run_spec
 from roto.rl.runner import Trainer
+from tests.conftest import SHADOW_BANK
 from tests.rl.toy_env import ToyEnv
 
 TINY = ["network.encoder=[16]", "network.policy_head=[8]", "network.value_head=[8]", "ppo.rollouts=4",
@@ -17,15 +20,15 @@ def test_env_overrides_set_any_env_field_and_win_over_flags():
 
 
 def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_wins(tmp_path):
-    base = tmp_path / "aided.yaml"
+    base, banks = tmp_path / "aided.yaml", pathlib.Path(SHADOW_BANK).parent  # the reference controller's banks
     base.write_text(
-        "extends: baoding_cpu\ntraining_aids:\n  replay_starts: banks/{robot}.npz\n  replay_share: 0.25\n"
-        "  tolerance_start: 0.025\n"
+        f"extends: baoding_cpu\ntraining_aids:\n  replay_starts: {banks}/{{robot}}_preswap.npz\n"
+        "  replay_share: 0.25\n  tolerance_start: 0.025\n"
     )
     (tmp_path / "more.yaml").write_text("extends: aided.yaml\ntraining_aids:\n  replay_share: 0.5\n")
     spec = build_run_spec("Baoding", "Allegro", "blind", str(tmp_path / "more.yaml"), ["env.tolerance_start=0.02"])
     assert (spec.env.task, spec.env.robot) == ("baoding", "allegro")  # names in any case, as roto.make takes them
-    assert (spec.env.replay_starts, spec.env.replay_share) == ("banks/allegro.npz", 0.5)  # merged through extends
+    assert (spec.env.replay_starts, spec.env.replay_share) == (f"{banks}/allegro_preswap.npz", 0.5)  # through extends
     assert spec.env.tolerance_start == 0.02 and spec.agent.ppo.epochs == 4  # the override wins; baoding_cpu's agent
     assert spec.env.without_training_aids() == build_run_spec("baoding", "allegro", "blind", "baoding_cpu").env
     base.write_text("extends: baoding_cpu\ntraining_aids:\n  num_envs: 4096\n")
