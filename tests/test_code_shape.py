@@ -58,8 +58,31 @@ def imported_modules(path: pathlib.Path) -> set[str]:
 def test_lower_layers_never_import_higher_ones():
     wrong = []
     for package, forbidden in LAYERS.items():
-        for path in sorted((ROOT / package).rglob("*.py")):
+        paths = sorted((ROOT / "roto" / package).rglob("*.py"))
+        assert paths, f"no Python files under roto/{package}"
+        for path in paths:
             wrong += [
                 f"{path.relative_to(ROOT)} imports {m}" for m in imported_modules(path) if m.startswith(forbidden)
             ]
+    assert not wrong, wrong
+
+
+def private_reads(path: pathlib.Path) -> list[str]:
+    """``obj._name`` reads of another object's private attribute in ``path`` (``self._x`` and
+    ``cls._x`` are the object's own; dunders are Python's)."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__"):
+            if not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls")):
+                found.append(f"{path.relative_to(ROOT)}:{node.lineno} reads .{node.attr}")
+    return found
+
+
+def test_training_aids_know_their_env_only_through_the_protocol():
+    """An aid is built from an ``AidHost`` and sees steps through a ``StepContext``: it never imports
+    the env nor reads another object's private state (roto/envs/aids/protocol.py)."""
+    paths = sorted((ROOT / "roto" / "envs" / "aids").rglob("*.py"))
+    assert len(paths) >= 5
+    wrong = [f"{p.relative_to(ROOT)} imports {m}" for p in paths for m in imported_modules(p) if "roto_env" in m]
+    wrong += [read for path in paths for read in private_reads(path)]
     assert not wrong, wrong

@@ -58,11 +58,11 @@ class EnvConfig:
             task's own starts (``without_training_aids``).
         replay_record_lead: a training aid beside ``replay_starts`` (0: off): the training envs'
             own states this many control steps before each rise of the task's headline metric
-            (a Baoding swap) join the bank they replay from (``roto.envs.event_recorder``).
+            (a Baoding swap) join the bank they replay from (``roto.envs.aids.event_recorder``).
         replay_record_capacity: the most states so recorded (the oldest replaced first).
         tolerance_start: a training aid for a task with a success radius (Baoding; 0: off): the
             radius starts this wide (m) and narrows to the task's own as the training episodes'
-            headline metric rises (``roto.envs.tolerance_curriculum``).
+            headline metric rises (``roto.envs.aids.tolerance``).
         tolerance_target: the headline metric per training episode (Baoding: rotations) at which
             the radius is the task's own.
         swap_min_turn: a training aid for Baoding (0: off): a swap earns its reward only when the
@@ -164,7 +164,7 @@ class EnvConfig:
                 raise ValueError(f"{name} must be a number >= 0, got {value!r}")
         if start == 0.0:
             return
-        own = getattr(get_task(self.task), "success_radius", None)
+        own = get_task(self.task).parameters.get("success_radius")
         if own is None:
             raise ValueError(
                 f"tolerance_start applies to a task with a success radius (baoding); task {self.task!r} has none"
@@ -181,7 +181,7 @@ class EnvConfig:
         value = self.swap_min_turn
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 0.5:
             raise ValueError(f"swap_min_turn must be a number of turns in [0, 0.5] (0: off), got {value!r}")
-        if value > 0.0 and not getattr(get_task(self.task), "round_swaps_aid", False):
+        if value > 0.0 and "swap_min_turn" not in get_task(self.task).parameters:
             raise ValueError(f"swap_min_turn applies to a task with swaps (baoding); task {self.task!r} has none")
 
     def _check_device(self) -> None:

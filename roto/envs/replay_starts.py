@@ -63,6 +63,7 @@ BANK_BOUND = 1e3
 """The largest magnitude a bank's value may have: recorded positions (m, rad), velocities and
 joint targets of a hand the size of a hand stay far below it; NaN, inf or 1e30 are a broken file."""
 
+
 def read_bank(path: str | pathlib.Path) -> dict[str, np.ndarray]:
     """The arrays of the ``.npz`` bank ``path``, read without pickle.
 

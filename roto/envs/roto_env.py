@@ -11,7 +11,7 @@ import dataclasses
 import functools
 import operator
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 import gymnasium as gym
 import mujoco
@@ -19,19 +19,17 @@ import numpy as np
 import torch
 
 from roto.envs.action_checks import check_action_finite, check_action_layout
+from roto.envs.aids import AidHost, StepContext, TrainingAid, build_aids
 from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
-from roto.envs.event_recorder import EventRecorder, event_recorder_for, record_events
 from roto.envs.frames import observation_frame
 from roto.envs.indices import SceneIndices
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, task_frame
-from roto.envs.replay_starts import ReplayBank, load_replay_bank
 from roto.envs.selections import Selected, Selections
 from roto.envs.spaces import BoundedBox
-from roto.envs.start_draw import draw_candidates, draw_starts
+from roto.envs.start_draw import draw_candidates, draw_starts, first_frame
 from roto.envs.start_pool import StartPool, check_balls_start_clear
-from roto.envs.tolerance_curriculum import tolerance_curriculum_for, update_tolerance
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
 from roto.sim.backend import Backend, make_backend
@@ -39,6 +37,8 @@ from roto.sim.host_sync import deliberate_host_sync, resolve_device
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
 from roto.tasks.base import TaskInputs
+
+AidT = TypeVar("AidT", bound=TrainingAid)
 
 DEVICE_CHECK_EVERY = 16
 """Steps between the host reads of a GPU env (pool of starts, action finiteness)."""
@@ -93,13 +93,10 @@ class RotoEnv:
         self._target = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
         self._last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
         self._zero_qvel = torch.zeros(self.num_envs, self.model.nv, dtype=torch.float64, device=self.device)
-        self.replay_bank = self._load_replay_bank()
-        replaying = self.replay_bank is not None and config.replay_share > 0.0
-        self._replayed_task_fields = tuple(self.replay_bank.task) if replaying else ()
-        self.recorder = event_recorder_for(self)  # None unless the config records its own events
-        self.curriculum = tolerance_curriculum_for(self)  # None unless the config widens the task's radius
-        if config.swap_min_turn > 0.0:  # training only: pay only the swaps that follow a turn (roto.tasks.round_swaps)
-            self.task_state.min_turn.fill_(config.swap_min_turn)
+        host = AidHost(config, self.task, self.task_state, self.robot, self.device, self.model, self._start_frame)
+        self.aids: tuple[TrainingAid, ...] = build_aids(host)  # training only: none in an evaluation env
+        self._start_task_fields = tuple(name for aid in self.aids for name in aid.start_task_fields())
+        self._watching_aids = tuple(aid for aid in self.aids if aid.watches_steps)
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
         self._term_sums: dict[str, torch.Tensor] = {}
         self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
@@ -139,8 +136,8 @@ class RotoEnv:
             with deliberate_host_sync(self.device):
                 self._starts.ensure(self.check_every * self.num_envs)
         self._stack.reset(frame)
-        if self.recorder is not None:  # every episode starts over: no metric to rise from
-            self.recorder.last_metric.zero_()
+        for aid in self.aids:
+            aid.on_reset()
         self._needs_reset = False
         return self._stack.observation(), {}
 
@@ -182,12 +179,11 @@ class RotoEnv:
         obs = self._stack.observation()
 
         done = terminated | truncated
-        if self.recorder is not None or self.curriculum is not None:  # training aids fed by the headline metric
+        if self._watching_aids:  # training aids fed by the headline metric, before the resets
             metric = self.task.metrics(self.task_state)[self.task.headline_metric]
-            if self.recorder is not None:
-                record_events(self, sim, metric, done)
-            if self.curriculum is not None:
-                update_tolerance(self, metric, done)
+            seen = StepContext(sim.qpos, sim.qvel, self._target, self.task_state, metric, self._episode.length, done)
+            for aid in self._watching_aids:
+                aid.observe(seen)
         info: dict[str, Any] = {"reward_terms": result.reward_terms, "nonfinite": diverged}
         # a step without resets skips them, unless asking would wait for the device: then the reset
         # runs every step, masked (a world that did not finish is left as it was)
@@ -226,9 +222,7 @@ class RotoEnv:
             "nonfinite_resets": self.nonfinite_resets,
             "needs_reset": self._needs_reset,
             "since_check": self._since_check,
-            **({"replay_bank": self.replay_bank.state_dict()} if self.replay_bank is not None else {}),
-            **({"event_recorder": self.recorder.state_dict()} if self.recorder is not None else {}),
-            **({"tolerance_curriculum": self.curriculum.state_dict()} if self.curriculum is not None else {}),
+            **{aid.state_key: aid.state_dict() for aid in self.aids if aid.state_key},
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -247,12 +241,9 @@ class RotoEnv:
             self._starts.load_state_dict(state["starts"], self.device)
         else:  # saved before episode starts were pooled: draw afresh
             self._starts.clear()
-        if "replay_bank" in state:  # the states the run drew from, whatever the file holds now
-            self.replay_bank = ReplayBank.from_state_dict(state["replay_bank"], self.device)
-        if "event_recorder" in state:
-            self.recorder = EventRecorder.from_state_dict(state["event_recorder"], self.device)
-        if "tolerance_curriculum" in state:
-            self.curriculum.load_state_dict(state["tolerance_curriculum"])
+        for aid in self.aids:
+            if aid.state_key in state:
+                aid.load_state_dict(state[aid.state_key])
         self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
         if "starts" in state and "since_check" in state:  # the pool as saved covers the steps until the next
@@ -261,6 +252,15 @@ class RotoEnv:
             self._since_check = 0  # where what a draw returns changes meanwhile, as a bank of recorded states)
             if not self._needs_reset:
                 self._starts.ensure(self.check_every * self.num_envs)
+
+    def aid(self, kind: type[AidT]) -> AidT | None:
+        """The env's training aid of type ``kind`` (``roto.envs.aids``), or None."""
+        return next((aid for aid in self.aids if isinstance(aid, kind)), None)
+
+    def aid_metrics(self) -> dict[str, torch.Tensor]:
+        """The training aids' scalars ("train/<name>" -> () tensor on the env's device; reading one
+        waits for the device); empty without aids."""
+        return {name: value for aid in self.aids for name, value in aid.metrics().items()}
 
     @property
     def nonfinite_resets(self) -> int:
@@ -349,7 +349,7 @@ class RotoEnv:
         rows = done[:, None]
         self.backend.set_state_where(done, start["qpos"], start.get("qvel", self._zero_qvel))
         self.task.reset(self.task_state, done)
-        for name in self._replayed_task_fields:  # the task state a replayed start was recorded in
+        for name in self._start_task_fields:  # the task state an aid's start was recorded in
             field = getattr(self.task_state, name)
             where = done.view(-1, *[1] * (field.dim() - 1))
             setattr(self.task_state, name, torch.where(where, start[f"task/{name}"].to(field.dtype), field))
@@ -362,16 +362,18 @@ class RotoEnv:
         return {name: start[f"frame/{name}"] for name in self.groups}
 
     def _draw_starts(self, n: int) -> dict[str, torch.Tensor]:
-        """n episode starts (``roto.envs.start_draw.draw_starts``)."""
-        return draw_starts(self, n, self._generator)
+        """n episode starts: the task's own (``roto.envs.start_draw.draw_starts``), drawn through
+        each training aid in turn (an aid may start some elsewhere)."""
+        draw = functools.partial(draw_starts, self, generator=self._generator)
+        for aid in self.aids:
+            draw = functools.partial(aid.draw_starts, draw=draw, generator=self._generator)
+        return draw(n)
 
-    def _load_replay_bank(self) -> ReplayBank | None:
-        """The recorded states the config's ``replay_starts`` names, on the env's device (or None)."""
-        path = self.config.replay_starts
-        if path is None:
-            return None
-        bank = load_replay_bank(path, self.model, self.robot.name, self.task.name, self.task_state, self.num_actions)
-        return bank.to(self.device)
+    def _start_frame(
+        self, qpos: torch.Tensor, qvel: torch.Tensor, target: torch.Tensor, task_rows: dict[str, torch.Tensor]
+    ) -> dict[str, torch.Tensor]:
+        """The first frame ("frame/<group>" rows) of starts an aid draws (``start_draw.first_frame``)."""
+        return first_frame(self, qpos, qvel, target, task_rows)[0]
 
     def _draw_candidates(self, n: int, generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
         """n candidate starts (``roto.envs.start_draw.draw_candidates``), drawn from ``generator``

@@ -1,9 +1,8 @@
-"""Candidate episode starts of a ``RotoEnv``: the task's own starts, and recorded states mixed in.
+"""Episode starts of a ``RotoEnv``: the task's own, and the first frame of any start.
 
-A start is, with probability ``EnvConfig.replay_share``, a state drawn from the env's bank of
-recorded states (``roto.envs.replay_starts``) with the task state it was recorded in, kept as
-recorded; otherwise one of the task's own starts: the hand at its default pose plus joint noise
-with the task's balls placed, at rest, redrawn until valid (``roto.envs.start_pool.draw_valid_starts``).
+The task's own start is the hand at its default pose plus joint noise with the task's balls
+placed, at rest, redrawn until valid (``roto.envs.start_pool.draw_valid_starts``); training aids
+may start episodes elsewhere (``roto.envs.aids``).
 """
 
 from __future__ import annotations
@@ -13,7 +12,6 @@ from typing import TYPE_CHECKING
 
 import torch
 
-from roto.envs.event_recorder import with_recorded
 from roto.envs.start_pool import contact_depth, draw_valid_starts
 from roto.tasks.base import uniform
 
@@ -22,44 +20,10 @@ if TYPE_CHECKING:
 
 
 def draw_starts(env: RotoEnv, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
-    """n valid episode starts of ``env``: each is, with probability ``replay_share``, a recorded state
-    (``replayed_starts``), else one of the task's own starts (``draw_candidates``, redrawn until
-    valid). Rows as ``draw_candidates``' without the depths, plus "replayed" (n,) bool and the
-    recorded task state fields ("task/<field>", zero where fresh) when the env replays."""
-    fresh = functools.partial(draw_candidates, env, generator=generator)
-    share, bank = env.config.replay_share, env.replay_bank
-    if bank is None or share == 0.0:
-        return draw_valid_starts(fresh, n, env.robot.name)
-    replayed = torch.rand(n, generator=generator, device=env.device) < share
-    parts = []
-    if bool(replayed.any()):
-        parts.append((replayed, replayed_starts(env, int(replayed.sum()), generator)))
-    if not bool(replayed.all()):
-        own = draw_valid_starts(fresh, int((~replayed).sum()), env.robot.name)
-        k = len(own["qpos"])
-        own.update({f"task/{name}": values.new_zeros((k, *values.shape[1:])) for name, values in bank.task.items()})
-        parts.append((~replayed, own))
-    starts = {name: rows.new_zeros((n, *rows.shape[1:])) for name, rows in parts[0][1].items()}
-    for mask, rows in parts:
-        for name, value in rows.items():
-            starts[name][mask] = value
-    starts["replayed"] = replayed
-    return starts
-
-
-def replayed_starts(env: RotoEnv, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
-    """n starts drawn uniformly from the env's bank of recorded states: their qpos, qvel, joint
-    targets, recorded task state ("task/<field>") and first frame, rows as ``draw_starts``'."""
-    bank = env.replay_bank
-    if env.recorder is None:
-        pick = torch.randint(len(bank), (n,), generator=generator, device=env.device)
-    else:  # the file's states and the env's own recorded ones, drawn alike
-        bank, pick = with_recorded(bank, env.recorder, n, generator)
-    qpos, qvel, target = bank.qpos[pick], bank.qvel[pick], bank.target[pick]
-    task_rows = {name: values[pick] for name, values in bank.task.items()}
-    frame, _ = first_frame(env, qpos, qvel, target, task_rows)
-    recorded = {f"task/{name}": rows for name, rows in task_rows.items()}
-    return {"qpos": qpos, "qvel": qvel, "target": target, **recorded, **frame}
+    """n valid episode starts of the task's own (``draw_candidates``, redrawn until valid): rows as
+    ``draw_candidates``' without the depths. A training aid may draw others instead
+    (``roto.envs.aids.TrainingAid.draw_starts``)."""
+    return draw_valid_starts(functools.partial(draw_candidates, env, generator=generator), n, env.robot.name)
 
 
 def first_frame(

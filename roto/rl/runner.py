@@ -222,9 +222,10 @@ class Trainer:
             t_inference += t1 - t0
             t_sim += t2 - t1
         scalars = {"perf/inference_s": t_inference, "perf/simulation_s": t_sim}
-        if getattr(self.env, "curriculum", None) is not None:  # a training aid's state, read once per update
+        aid_metrics = self.env.aid_metrics()
+        if aid_metrics:  # the training aids' state, read once per update
             with deliberate_host_sync(self.device):
-                scalars["train/success_radius"] = float(self.env.curriculum.radius())
+                scalars.update({name: float(value) for name, value in aid_metrics.items()})
         return scalars
 
     def _evaluate(self) -> dict[str, float]:

@@ -13,7 +13,15 @@ import torch
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
 from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where, zero_on_host
-from roto.tasks.base import PALM_DROP_LIMIT, Marker, StepResult, TaskInputs, clear_where, uniform
+from roto.tasks.base import (
+    PALM_DROP_LIMIT,
+    Marker,
+    StepResult,
+    TaskInputs,
+    clear_where,
+    set_state_parameter,
+    uniform,
+)
 from roto.tasks.pair_turns import pair_turns
 from roto.tasks.round_swaps import paid_swaps, pair_turn_step
 
@@ -144,12 +152,12 @@ class Baoding:
     version = 1
     """v1: balls dropped from above, roto's diagonal (or side-by-side) targets; v0 started the balls
     on targets where they rest, partly inside the hand."""
-    round_swaps_aid = True
-    """Has the training-only round-swaps aid (``EnvConfig.swap_min_turn``, ``roto.tasks.round_swaps``)."""
     metric_names = ("swaps", "rotations")
     headline_metric = "rotations"
-    success_radius = SUCCESS_RADIUS
-    """The benchmark's latch radius (m); a training curriculum may start wider (``roto.envs.tolerance_curriculum``)."""
+    parameters = MappingProxyType({"success_radius": SUCCESS_RADIUS, "swap_min_turn": 0.0})
+    """What training aids may change: the latch radius (m; a tolerance curriculum starts it wider,
+    ``roto.envs.aids.tolerance``) and the turns a paid swap must follow (0: every swap is paid; the
+    round-swaps aid sets it, ``roto.tasks.round_swaps``)."""
     reference_name = "reference controller"
     reference = MappingProxyType({"shadow": 7.31, "shadow_lite": 5.50, "allegro": 5.03, "orca": 5.78})
     """Rotations per 10 s of the predictive-sampling reference controller, 16 episodes each,
@@ -182,6 +190,10 @@ class Baoding:
             direction=torch.zeros(num_envs, dtype=torch.float64, device=device),
             min_turn=torch.zeros((), dtype=torch.float64, device=device),
         )
+
+    def set_parameter(self, state: BaodingState, name: str, value: float | torch.Tensor) -> None:
+        """Set ``success_radius`` or ``swap_min_turn`` of every world (``Task.set_parameter``)."""
+        set_state_parameter(state, {"success_radius": "radius", "swap_min_turn": "min_turn"}, name, value)
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:
         """Clear the latches, swap count and assignment (ball a -> T_a, ball b -> T_b), and the ball

@@ -85,6 +85,9 @@ class Task(Protocol):
     path_metric_names: tuple[str, ...]
     """Episode measures read from the balls' whole path and the episode's metrics (``path_metrics``);
     evaluation reports them, training never sees them. May be empty."""
+    parameters: Mapping[str, float]
+    """{name: the benchmark's value} of the task parameters a training aid may change
+    (``set_parameter``); may be empty."""
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """The free objects this task puts in the scene for ``robot``."""
@@ -124,6 +127,12 @@ class Task(Protocol):
         and its ``metric_names`` at its end (``metrics``)."""
         ...
 
+    def set_parameter(self, state: object, name: str, value: float | torch.Tensor) -> None:
+        """Set task parameter ``name`` (one of ``parameters``) of every world in ``state`` to
+        ``value`` (a float or a () tensor on the state's device), in place, without reading the
+        device. Raises ValueError naming the valid parameters for any other name."""
+        ...
+
     def derived_metrics(self, episode: Mapping[str, float]) -> dict[str, float]:
         """Those ``path_metric_names`` of one episode that follow from its other measures alone
         (``episode``: its metrics and path metrics at its end), for which ``path_metrics`` uses this
@@ -142,3 +151,12 @@ def uniform(
 def clear_where(values: torch.Tensor, mask: torch.Tensor) -> None:
     """Zero, in place, the rows of ``values`` (B, ...) where ``mask`` (B,) bool is True."""
     values.masked_fill_(mask.view(-1, *([1] * (values.dim() - 1))), 0)
+
+
+def set_state_parameter(state: object, fields: Mapping[str, str], name: str, value: float | torch.Tensor) -> None:
+    """``Task.set_parameter`` for a task whose parameter ``name`` lives in ``state``'s () tensor
+    field ``fields[name]``: copied in place (a tensor on the device is never read back)."""
+    if name not in fields:
+        raise ValueError(f"unknown task parameter {name!r}; this task's parameters: {sorted(fields)}")
+    field = getattr(state, fields[name])
+    field.copy_(torch.as_tensor(value, dtype=field.dtype, device=field.device))

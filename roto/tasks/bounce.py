@@ -11,7 +11,15 @@ import torch
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec
 from roto.tasks.arrays import as_dtype_of, squared_norm, where
-from roto.tasks.base import PALM_DROP_LIMIT, Marker, StepResult, TaskInputs, clear_where, uniform
+from roto.tasks.base import (
+    PALM_DROP_LIMIT,
+    Marker,
+    StepResult,
+    TaskInputs,
+    clear_where,
+    set_state_parameter,
+    uniform,
+)
 
 BALL = BallSpec(name="ball", radius=0.035, mass=0.030, friction=1.0)
 SPAWN_HEIGHT = 0.10
@@ -73,6 +81,12 @@ class Bounce:
     """Bounces per 10 s of each hand's scripted policy, ``roto demo`` (docs/robots.md)."""
     observation_size = 3
     path_metric_names = ()
+    parameters = MappingProxyType({})
+    """Bounce has no parameter a training aid may change."""
+
+    def set_parameter(self, state: BounceState, name: str, value: float | torch.Tensor) -> None:
+        """Bounce has no parameters (``Task.set_parameter``): refuses every name."""
+        set_state_parameter(state, {}, name, value)
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """One 70 mm, 30 g ball for every hand."""

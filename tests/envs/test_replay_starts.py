@@ -6,6 +6,7 @@ import pytest
 import torch
 
 import roto
+from roto.envs.aids.replayed_starts import ReplayedStarts
 from roto.envs.config import EnvConfig
 from roto.rl.settings import TrainSettings
 from tests.conftest import SHADOW_BANK
@@ -41,7 +42,7 @@ def test_every_replayed_start_is_the_recorded_state_with_its_latches():
     env = replay_env(1.0, extra_groups=("task",))
     starts = env._draw_starts(32)
     assert starts["replayed"].all()
-    bank = env.replay_bank
+    bank = env.aid(ReplayedStarts).bank
     for q, v, t, swapped, latched in zip(
         starts["qpos"], starts["qvel"], starts["target"], starts["task/swapped"], starts["task/latched"], strict=True
     ):
@@ -115,7 +116,7 @@ def test_a_missing_states_file_is_refused_by_the_env_and_a_run_s_config_still_lo
         {"env": {"task": "baoding", "replay_starts": "/nowhere/states.npz", "replay_share": 0.5}, "total_steps": 10}
     )
     env = roto.make(**vars(settings.eval_env_config(num_envs=1)))
-    assert env.replay_bank is None
+    assert env.aid(ReplayedStarts) is None
     env.close()
 
 
@@ -142,7 +143,7 @@ def test_every_hands_bank_replays_in_its_own_scene_with_the_task_state_it_was_re
     bank_file = BANK.replace("shadow_preswap", f"{robot}_preswap")
     env = roto.make("baoding", robot=robot, num_envs=8, seed=0, replay_starts=bank_file, replay_share=1.0)
     obs, _ = env.reset()
-    saved, bank = np.load(bank_file), env.replay_bank
+    saved, bank = np.load(bank_file), env.aid(ReplayedStarts).bank
     physics = torch.from_numpy(env.backend.physics_state())
     for world in range(env.num_envs):  # each world is one recorded state, with its own latches
         k = int(torch.nonzero((bank.qpos == physics[world, 1 : 1 + env.model.nq]).all(dim=1))[0])

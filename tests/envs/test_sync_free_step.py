@@ -6,6 +6,8 @@ import pytest
 import torch
 
 import roto
+from roto.envs.aids.event_recorder import RecordedEvents
+from roto.envs.aids.tolerance import ToleranceAid
 from roto.registry import list_envs
 from tests.conftest import BAODING_AIDS, require_warp
 
@@ -82,9 +84,11 @@ def test_sync_free_step_with_the_baoding_training_aids_is_bit_identical_to_the_c
     (a, finished), (b, _) = rollout(reference, 150, after_step=top_up), rollout(candidate, 150)
     assert finished > 5, "too few episodes ended: the masked reset went untested"
     assert len(a) == len(b) and all(torch.equal(x, y) for x, y in zip(a, b, strict=True))
-    assert int(reference.recorder.recorded) > 0, "no state was recorded: the recorded bank went untested"
-    assert torch.equal(reference.recorder.recorded, candidate.recorder.recorded)
-    assert torch.equal(reference.curriculum.mean, candidate.curriculum.mean)
+    assert int(reference.aid(RecordedEvents).recorder.recorded) > 0, (
+        "no state was recorded: the recorded bank went untested"
+    )
+    assert torch.equal(reference.aid(RecordedEvents).recorder.recorded, candidate.aid(RecordedEvents).recorder.recorded)
+    assert torch.equal(reference.aid(ToleranceAid).curriculum.mean, candidate.aid(ToleranceAid).curriculum.mean)
 
 
 def test_sync_free_step_reports_a_non_finite_action_at_the_next_check():

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import torch
 
+from roto.envs.aids.replayed_starts import ReplayedStarts
 from roto.reference.baoding_controller import (
     BaodingReference,
     PreswapStates,
@@ -38,7 +39,7 @@ def test_from_a_recorded_preswap_state_the_controller_swaps_again(seed):
     env = reference_env("shadow", seed=seed, replay_starts=str(PRESWAP), replay_share=1.0)
     env.reset()
     physics = torch.from_numpy(env.backend.physics_state()[0, 1 : 1 + env.model.nq])
-    assert (env.replay_bank.qpos == physics).all(dim=1).any()  # a recorded state, exactly
+    assert (env.aid(ReplayedStarts).bank.qpos == physics).all(dim=1).any()  # a recorded state, exactly
     controller = controller_for(env)
     controller.start()
     swaps = 0
@@ -74,7 +75,7 @@ def test_the_controller_needs_one_world_on_the_cpu():
 
 
 def test_preswap_states_of_another_hand_are_refused():
-    with pytest.raises(ValueError, match="states of robot 'shadow', not 'allegro'"):
+    with pytest.raises(ValueError, match="states recorded on robot 'shadow', not this env's 'allegro'"):
         reference_env("allegro", seed=0, replay_starts=str(PRESWAP), replay_share=1.0)
 
 

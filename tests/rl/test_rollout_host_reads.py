@@ -5,6 +5,8 @@ tests/rl/test_training_gpu.py checks the same under CUDA's sync-debug mode."""
 
 import torch
 
+from roto.envs.aids.event_recorder import RecordedEvents
+from roto.envs.aids.tolerance import ToleranceAid
 from roto.envs.config import EnvConfig
 from roto.rl.config import load_agent_config
 from roto.rl.runner import Trainer, TrainSettings
@@ -29,7 +31,7 @@ def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch,
     settings = TrainSettings(env=env, total_steps=3 * agent.ppo.rollouts * env.num_envs)
     trainer = Trainer(settings, agent, tmp_path / "run", tensorboard=False)
     trainer.env.sync_free_step, trainer.env.check_every = True, 4  # as on a GPU
-    assert trainer.env.recorder is not None and trainer.env.curriculum is not None
+    assert trainer.env.aid(RecordedEvents) is not None and trainer.env.aid(ToleranceAid) is not None
     collect, collected = trainer._collect_rollout, []
 
     def collect_watched():

@@ -39,6 +39,9 @@ class ToyEnv:
         self._return = torch.zeros(self.num_envs)
         self._hits = torch.zeros(self.num_envs)
 
+    def aid_metrics(self) -> dict[str, torch.Tensor]:
+        return {}  # no training aids
+
     def _obs(self) -> dict[str, torch.Tensor]:
         return {"proprio": self._target.repeat(1, self.config.frame_stack)}
 

@@ -5,8 +5,9 @@ import pytest
 import torch
 
 import roto
+from roto.envs.aids import StepContext
+from roto.envs.aids.tolerance import EPISODE_WEIGHT, ToleranceAid, ToleranceCurriculum
 from roto.envs.config import EnvConfig
-from roto.envs.tolerance_curriculum import EPISODE_WEIGHT, ToleranceCurriculum, update_tolerance
 from roto.rl.settings import TrainSettings
 from roto.tasks.baoding import SUCCESS_RADIUS, baoding_rule
 
@@ -50,16 +51,17 @@ def test_a_baoding_env_starts_wide_narrows_as_its_episodes_rotate_and_resumes_ex
     env.reset()
     env.task_state.swaps.fill_(2)  # every world has made one rotation when its episode ends
     rotations = env.task.metrics(env.task_state)["rotations"]
-    update_tolerance(env, rotations, torch.ones(4, dtype=torch.bool))
+    ended = torch.ones(4, dtype=torch.bool)
+    env.aid(ToleranceAid).observe(StepContext(None, None, None, env.task_state, rotations, None, ended))
     mean = 1.0 - (1.0 - EPISODE_WEIGHT) ** 4
     assert float(env.task_state.radius) == pytest.approx(SUCCESS_RADIUS + 0.02 * (1.0 - mean / 2.0))
     saved = env.state_dict()
     other = roto.make("baoding", robot="shadow", num_envs=4, seed=5, tolerance_start=0.03, tolerance_target=2.0)
     other.load_state_dict(saved)
-    assert torch.equal(other.curriculum.mean, env.curriculum.mean)
+    assert torch.equal(other.aid(ToleranceAid).curriculum.mean, env.aid(ToleranceAid).curriculum.mean)
     assert torch.equal(other.task_state.radius, env.task_state.radius)
     plain = roto.make("baoding", robot="shadow", num_envs=4, seed=0)
-    assert plain.curriculum is None and float(plain.task_state.radius) == SUCCESS_RADIUS
+    assert plain.aid(ToleranceAid) is None and float(plain.task_state.radius) == SUCCESS_RADIUS
 
 
 @pytest.mark.parametrize(

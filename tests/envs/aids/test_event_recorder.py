@@ -4,7 +4,8 @@
 import pytest
 import torch
 
-from roto.envs.event_recorder import EventRecorder
+from roto.envs.aids.event_recorder import EventRecorder, RecordedEvents
+from roto.envs.aids.replayed_starts import ReplayedStarts
 
 B, NQ = 3, 2
 
@@ -159,13 +160,13 @@ def test_an_env_records_its_own_states_lead_steps_before_each_bounce(tmp_path):
                 expected.append(logs["qpos"][t - LEAD][w])
             last[w] = 0 if logs["done"][t][w] else int(logs["bounces"][t][w])
             length[w] = 0 if logs["done"][t][w] else length[w]
-    bank, held = env.recorder.as_bank(())
+    bank, held = env.aid(RecordedEvents).recorder.as_bank(())
     assert int(held) == len(expected) > 10
     for k, qpos in enumerate(expected):
         assert torch.equal(bank.qpos[k], qpos)
     starts = env._draw_starts(256)
     replayed = starts["qpos"][starts["replayed"]]
-    file_states = env.replay_bank.qpos
+    file_states = env.aid(ReplayedStarts).bank.qpos
     own = [(bank.qpos[: int(held)] == q).all(dim=1).any() for q in replayed]
     mine = [(file_states == q).all(dim=1).any() for q in replayed]
     assert all(a or b for a, b in zip(own, mine, strict=True)) and any(own) and any(mine)
@@ -179,7 +180,7 @@ def test_a_resumed_env_records_and_draws_as_the_original(tmp_path):
     saved = first.state_dict()
     second = recording_env(bank, replay_share=0.9, seed=7)
     second.load_state_dict(saved)
-    assert int(second.recorder.recorded) == int(first.recorder.recorded) > 0
+    assert int(second.aid(RecordedEvents).recorder.recorded) == int(first.aid(RecordedEvents).recorder.recorded) > 0
     gen = torch.Generator().manual_seed(2)
     for _ in range(60):
         action = torch.rand(WORLDS, first.num_actions, generator=gen) * 2 - 1
@@ -200,21 +201,25 @@ def test_a_resumed_env_draws_its_starts_when_the_original_does_from_the_states_r
     for _ in range(400):  # the scripted policy bounces: events to record; drops: resets
         obs, _, terminated, truncated, _ = first.step(policy(obs))
         policy.reset(terminated | truncated)
-        if 0 < first._starts.remaining < WORLDS and first.recorder.recorded > 0:
+        if 0 < first._starts.remaining < WORLDS and first.aid(RecordedEvents).recorder.recorded > 0:
             break
     assert 0 < first._starts.remaining < WORLDS
     second = recording_env(own_bank(tmp_path / "other.npz"), replay_share=0.9, seed=7)
     second.load_state_dict(first.state_dict())
-    recorded, drew_after_new_states = int(first.recorder.recorded), False
+    recorded, drew_after_new_states = int(first.aid(RecordedEvents).recorder.recorded), False
     for _ in range(600):
         left, action = first._starts.remaining, policy(obs)
         obs, _, terminated, truncated, _ = first.step(action)
         obs_b, *_ = second.step(action)
         assert all(torch.equal(obs[k], obs_b[k]) for k in obs)
         policy.reset(terminated | truncated)
-        drew_after_new_states |= first._starts.remaining > left and int(first.recorder.recorded) > recorded
+        drew_after_new_states |= (
+            first._starts.remaining > left and int(first.aid(RecordedEvents).recorder.recorded) > recorded
+        )
     assert drew_after_new_states
-    assert torch.equal(first.recorder.bank["qpos"], second.recorder.bank["qpos"])
+    assert torch.equal(
+        first.aid(RecordedEvents).recorder.bank["qpos"], second.aid(RecordedEvents).recorder.bank["qpos"]
+    )
 
 
 def test_recording_needs_replayed_starts_and_evaluation_never_records():
@@ -232,7 +237,7 @@ def test_recording_needs_replayed_starts_and_evaluation_never_records():
 def test_a_reset_mid_run_starts_every_metric_over(tmp_path):
     env = recording_env(own_bank(tmp_path / "bank.npz"))
     play(env, 80)
-    assert env.recorder.last_metric.any()  # some episode has bounced
+    assert env.aid(RecordedEvents).recorder.last_metric.any()  # some episode has bounced
     env.reset()
-    assert not env.recorder.last_metric.any()
+    assert not env.aid(RecordedEvents).recorder.last_metric.any()
     env.close()

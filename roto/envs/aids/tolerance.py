@@ -1,7 +1,7 @@
 """A training-only tolerance curriculum: the task's success radius starts wide and narrows to the
 benchmark's as the training episodes succeed.
 
-For a task with a success radius (Baoding's latch radius, ``Task.success_radius``): the radius is
+For a task with a success radius (Baoding's latch radius, the task parameter ``success_radius``): the radius is
 ``end + (start - end) * max(0, 1 - mean / target)``, where ``mean`` is a running mean of the headline
 metric (Baoding: rotations) over the training episodes that ended so far (each ended episode
 weighs ``EPISODE_WEIGHT``), ``start`` is ``EnvConfig.tolerance_start`` and ``end`` the task's own
@@ -14,12 +14,10 @@ runs on the env's device in fixed shapes, never reading it. Evaluation envs neve
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import torch
 
-if TYPE_CHECKING:
-    from roto.envs.roto_env import RotoEnv
+from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
 
 EPISODE_WEIGHT = 0.01
 """Weight of one ended episode in the running mean (about the last hundred episodes count)."""
@@ -58,19 +56,30 @@ class ToleranceCurriculum:
         self.mean = state["mean"].clone().to(self.mean.device)
 
 
-def tolerance_curriculum_for(env: RotoEnv) -> ToleranceCurriculum | None:
-    """The curriculum ``env.config`` asks for (``tolerance_start`` > 0), its task's radius set to the
-    start; None when it asks for none."""
-    config = env.config
-    if config.tolerance_start == 0.0:
-        return None
-    mean = torch.zeros((), dtype=torch.float64, device=env.device)
-    curriculum = ToleranceCurriculum(config.tolerance_start, env.task.success_radius, config.tolerance_target, mean)
-    env.task_state.radius.copy_(curriculum.radius())
-    return curriculum
+class ToleranceAid(TrainingAid):
+    """The aid: a ``ToleranceCurriculum`` fed the headline metric of every ended training episode,
+    setting the task's ``success_radius`` parameter (``EnvConfig.tolerance_start`` > 0)."""
 
+    state_key = "tolerance_curriculum"
+    watches_steps = True
 
-def update_tolerance(env: RotoEnv, metric: torch.Tensor, done: torch.Tensor) -> None:
-    """This step's ended episodes (``done`` (B,), their headline ``metric`` (B,)) into
-    ``env.curriculum``, before their task state resets; the task's radius follows."""
-    env.task_state.radius.copy_(env.curriculum.update(metric, done))
+    def __init__(self, host: AidHost) -> None:
+        config = host.config
+        mean = torch.zeros((), dtype=torch.float64, device=host.device)
+        end = host.task.parameters["success_radius"]
+        self.curriculum = ToleranceCurriculum(config.tolerance_start, end, config.tolerance_target, mean)
+        self.task, self.task_state = host.task, host.task_state
+        self.task.set_parameter(self.task_state, "success_radius", self.curriculum.radius())
+
+    def observe(self, step: StepContext) -> None:
+        """This step's ended episodes into the running mean, before their task state resets."""
+        self.task.set_parameter(self.task_state, "success_radius", self.curriculum.update(step.metric, step.done))
+
+    def metrics(self) -> dict[str, torch.Tensor]:
+        return {"train/success_radius": self.curriculum.radius()}
+
+    def state_dict(self) -> dict[str, object]:
+        return self.curriculum.state_dict()
+
+    def load_state_dict(self, state: dict[str, object]) -> None:
+        self.curriculum.load_state_dict(state)

@@ -4,7 +4,7 @@ Reference-state initialisation from the agent's own successes: where the task's 
 rises in a world (a Baoding swap, a Bounce bounce), the state that world was in ``lead`` control
 steps earlier joins a bank of at most ``capacity`` states (the oldest replaced first), from which
 training episodes may start beside the recorded file's states (``EnvConfig.replay_record_lead``,
-``roto.envs.start_draw``). Only states of the same episode count: the event must come more than
+``roto.envs.aids.replayed_starts``). Only states of the same episode count: the event must come more than
 ``lead`` steps after the episode's start.
 
 Every step the recorder keeps each world's last ``lead`` states in a ring (physics, joint targets,
@@ -15,15 +15,11 @@ worlds without an event write into a spare row past the bank's end.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import torch
 
+from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
 from roto.envs.replay_starts import ReplayBank
-
-if TYPE_CHECKING:
-    from roto.envs.roto_env import RotoEnv
-    from roto.sim.backend import SimState
 
 
 @dataclass
@@ -123,25 +119,38 @@ class EventRecorder:
         )
 
 
-def event_recorder_for(env: RotoEnv) -> EventRecorder | None:
-    """The recorder ``env.config`` asks for (``replay_record_lead`` > 0), keeping the env's physics,
-    joint targets and the task fields its replay bank carries; None when it records nothing."""
-    config = env.config
-    if config.replay_record_lead == 0:
-        return None
-    b, f64 = env.num_envs, {"dtype": torch.float64, "device": env.device}
-    like = {"qpos": torch.zeros(b, env.model.nq, **f64), "qvel": torch.zeros(b, env.model.nv, **f64),
-            "target": torch.zeros(b, env.num_actions, **f64)}  # fmt: skip
-    like.update({f"task/{name}": getattr(env.task_state, name) for name in env.replay_bank.task})
-    return EventRecorder.empty(config.replay_record_lead, config.replay_record_capacity, like)
+class RecordedEvents(TrainingAid):
+    """The aid: records the training envs' own states ``lead`` steps before each rise of the task's
+    headline metric (``EnvConfig.replay_record_lead``); ``ReplayedStarts`` draws from them beside
+    its file's states."""
 
+    state_key = "event_recorder"
+    watches_steps = True
 
-def record_events(env: RotoEnv, sim: SimState, metric: torch.Tensor, done: torch.Tensor) -> None:
-    """Give ``env.recorder`` this control step: the state after it, the task's headline ``metric``
-    (B,) and the episodes' lengths, before the worlds where ``done`` (B,) reset."""
-    rows = {"qpos": sim.qpos, "qvel": sim.qvel, "target": env._target}
-    rows.update({f"task/{name}": getattr(env.task_state, name) for name in env.replay_bank.task})
-    env.recorder.observe(rows, metric, env._episode.length, done)
+    def __init__(self, host: AidHost, task_fields: tuple[str, ...]) -> None:
+        config, b = host.config, host.config.num_envs
+        sizes = {"qpos": host.model.nq, "qvel": host.model.nv, "target": host.robot.num_actions}
+        like = {name: torch.zeros(b, size, dtype=torch.float64, device=host.device) for name, size in sizes.items()}
+        like.update({f"task/{name}": getattr(host.task_state, name) for name in task_fields})
+        self.task_fields = task_fields
+        self.recorder = EventRecorder.empty(config.replay_record_lead, config.replay_record_capacity, like)
+        self.device = host.device
+
+    def observe(self, step: StepContext) -> None:
+        """Push this step's state; record the state ``lead`` steps back where the metric rose."""
+        rows = {"qpos": step.qpos, "qvel": step.qvel, "target": step.target}
+        rows.update({f"task/{name}": getattr(step.task_state, name) for name in self.task_fields})
+        self.recorder.observe(rows, step.metric, step.length, step.done)
+
+    def on_reset(self) -> None:
+        """Every episode starts over: no metric to rise from."""
+        self.recorder.last_metric.zero_()
+
+    def state_dict(self) -> dict[str, object]:
+        return self.recorder.state_dict()
+
+    def load_state_dict(self, state: dict[str, object]) -> None:
+        self.recorder = EventRecorder.from_state_dict(state, self.device)
 
 
 def with_recorded(bank: ReplayBank, recorder: EventRecorder, n: int, generator: torch.Generator):
