@@ -72,9 +72,9 @@ def private_reads(path: pathlib.Path) -> list[str]:
     ``cls._x`` are the object's own; dunders are Python's)."""
     found = []
     for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__"):
-            if not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls")):
-                found.append(f"{path.relative_to(ROOT)}:{node.lineno} reads .{node.attr}")
+        private = isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__")
+        if private and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls")):
+            found.append(f"{path.relative_to(ROOT)}:{node.lineno} reads .{node.attr}")
     return found
 
 
