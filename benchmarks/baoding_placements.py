@@ -110,7 +110,7 @@ def measure(name: str, steps: int) -> list[dict]:
             robots.ROBOTS[name] = robot
             hold = run_hold("baoding", name, num_envs=16, seed=0)
             env = reference_env(name, seed=0, episode_steps=steps)
-            lo, hi = env._idx.ctrl_lo.numpy(), env._idx.ctrl_hi.numpy()
+            lo, hi = env.indices.ctrl_lo.numpy(), env.indices.ctrl_hi.numpy()
             planner = PredictiveSampling(env.model, lo, hi, SamplingConfig(threads=2))
             episode = run_reference_episode(BaodingReference(env, planner, BaodingCostWeights()))
             planner.close()

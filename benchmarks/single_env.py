@@ -36,7 +36,7 @@ def visited_states(env: gym.Env, steps: int, seed: int) -> tuple[np.ndarray, np.
     for _ in range(steps):
         states.append(inner.backend.physics_state()[0])
         _, _, terminated, truncated, _ = env.step(env.action_space.sample())
-        targets.append(inner._target[0].numpy().copy())
+        targets.append(inner.joint_targets[0].numpy().copy())
         if terminated or truncated:
             env.reset()
     return np.stack(states), np.stack(targets)

@@ -85,7 +85,7 @@ def main() -> None:
             physics[threads].append(p)
             own[threads].append(o)
         env = envs[1]
-        rate = raw_physics_steps_per_s(env, env.backend.physics_state(), env._target.numpy(), substeps)
+        rate = raw_physics_steps_per_s(env, env.backend.physics_state(), env.joint_targets.numpy(), substeps)
         raw_ms.append(1e3 * args.num_envs * substeps / rate)
     for env in envs.values():
         env.close()

@@ -139,7 +139,7 @@ def _time_cpu(env: Any, actions: torch.Tensor) -> tuple[float, float]:
         first = (t * share) % num_envs
         worlds = slice(first, min(num_envs, first + share))
         states = env.backend.physics_state()[worlds]
-        raw_seconds += raw_physics_seconds(env, states, env._target[worlds].numpy(), substeps, scratch)
+        raw_seconds += raw_physics_seconds(env, states, env.joint_targets[worlds].numpy(), substeps, scratch)
         raw_steps += len(states) * substeps
     return num_envs * len(actions) / env_seconds, raw_steps / raw_seconds
 

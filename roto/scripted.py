@@ -141,7 +141,7 @@ class ScriptedBounce:
                 raise ValueError(f"no Bounce script for robot {env.robot.name!r}; scripted robots: {sorted(SCRIPTS)}")
             script = SCRIPTS[env.robot.name]
         self.script = script
-        idx = env._idx
+        idx = env.indices
         self._lo, self._hi = idx.ctrl_lo, idx.ctrl_hi
         joints = env.robot.actuated_joints
         self._pose = idx.act_qpos.take(idx.default_qpos)[0].clone()

@@ -10,7 +10,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import operator
-from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
 import gymnasium as gym
@@ -23,6 +22,7 @@ from roto.envs.aids import AidHost, StepContext, TrainingAid, build_aids
 from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
+from roto.envs.episode_book import EpisodeBook
 from roto.envs.frames import observation_frame
 from roto.envs.indices import SceneIndices
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, FrameStack, task_frame
@@ -42,14 +42,6 @@ AidT = TypeVar("AidT", bound=TrainingAid)
 
 DEVICE_CHECK_EVERY = 16
 """Steps between the host reads of a GPU env (pool of starts, action finiteness)."""
-
-
-@dataclass
-class _Episode:
-    """Running per-env episode statistics, each (B,)."""
-
-    length: torch.Tensor  # int64 control steps so far
-    ret: torch.Tensor  # float64 return so far
 
 
 def backend_for(config: EnvConfig, model: mujoco.MjModel) -> Backend:
@@ -82,25 +74,23 @@ class RotoEnv:
         self.backend = backend_for(config, self.model)
         self._generator = torch.Generator(device=self.device)
         self._generator.manual_seed(config.seed)
-        self._idx = SceneIndices.from_layout(self.layout, self.robot, self.model, self.device, config.touch)
+        # the parts other code reads: the scene's index sets, each world's joint targets (B, n_act)
+        # float64 and last action (B, n_act) float32 (the single-world step writes the last two in
+        # place), the episodes' statistics (EpisodeBook) and the training aids
+        self.indices = SceneIndices.from_layout(self.layout, self.robot, self.model, self.device, config.touch)
         self.num_actions = self.robot.num_actions
         self.task_state = self.task.init_state(self.robot, self.num_envs, self.device)
         self._stack = FrameStack(config.frame_stack)
-        self._episode = _Episode(
-            length=torch.zeros(self.num_envs, dtype=torch.int64, device=self.device),
-            ret=torch.zeros(self.num_envs, dtype=torch.float64, device=self.device),
-        )
-        self._target = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
-        self._last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
+        self.episodes = EpisodeBook.empty(self.num_envs, self.device)
+        self.joint_targets = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
+        self.last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
         self._zero_qvel = torch.zeros(self.num_envs, self.model.nv, dtype=torch.float64, device=self.device)
         host = AidHost(config, self.task, self.task_state, self.robot, self.device, self.model, self._start_frame)
         self.aids: tuple[TrainingAid, ...] = build_aids(host)  # training only: none in an evaluation env
         self._start_task_fields = tuple(name for aid in self.aids for name in aid.start_task_fields())
         self._watching_aids = tuple(aid for aid in self.aids if aid.watches_steps)
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
-        self._term_sums: dict[str, torch.Tensor] = {}
-        self._nonfinite_resets = torch.zeros((), dtype=torch.int64, device=self.device)
-        self._selections = Selections(self._idx, self.device, taxels=config.touch == "taxels")
+        self._selections = Selections(self.indices, self.device, taxels=config.touch == "taxels")
         # reading the device is free on the CPU and waits for a GPU. A sync-free step reads nothing:
         # resets run masked every step, and the pool of starts and the action check are read every
         # `check_every` steps, the pool holding enough starts for every world to reset on each of
@@ -153,35 +143,31 @@ class RotoEnv:
         if self._needs_reset:
             raise RuntimeError("call reset() before the first step()")
         action = self._check_action(action)
-        target = action_to_target(action.to(torch.float64), self._idx.ctrl_lo, self._idx.ctrl_hi)
-        self._target = smooth_target(target, self._target, self.config.action_smoothing)
-        self._last_action = action.to(torch.float32, copy=True)  # never alias the caller's tensor
+        target = action_to_target(action.to(torch.float64), self.indices.ctrl_lo, self.indices.ctrl_hi)
+        self.joint_targets = smooth_target(target, self.joint_targets, self.config.action_smoothing)
+        self.last_action = action.to(torch.float32, copy=True)  # never alias the caller's tensor
 
-        sim = self.backend.step(self._target)
+        sim = self.backend.step(self.joint_targets)
         selected = self._selections.of(sim)
         diverged = sim.diverged.to(self.device)
 
         inputs = self._task_inputs(selected)
         result = self.task.step(self.task_state, inputs)
         reward = functools.reduce(operator.add, result.reward_terms.values()).masked_fill(diverged, 0.0)
-        self._episode.length += 1
-        self._episode.ret += reward
-        for name, value in result.reward_terms.items():
-            if name in self._term_sums:
-                self._term_sums[name] += value
-            else:
-                self._term_sums[name] = value.clone()
+        self.episodes.add(reward, result.reward_terms)
         terminated = result.terminated | diverged
-        truncated = (self._episode.length >= self.config.episode_steps) & ~terminated
+        truncated = (self.episodes.length >= self.config.episode_steps) & ~terminated
 
-        frame = self._frame(selected, self._target, self._last_action, self._task_state_frame())
+        frame = self._frame(selected, self.joint_targets, self.last_action, self._task_state_frame())
         self._stack.push(frame)
         obs = self._stack.observation()
 
         done = terminated | truncated
         if self._watching_aids:  # training aids fed by the headline metric, before the resets
             metric = self.task.metrics(self.task_state)[self.task.headline_metric]
-            seen = StepContext(sim.qpos, sim.qvel, self._target, self.task_state, metric, self._episode.length, done)
+            seen = StepContext(
+                sim.qpos, sim.qvel, self.joint_targets, self.task_state, metric, self.episodes.length, done
+            )
             for aid in self._watching_aids:
                 aid.observe(seen)
         info: dict[str, Any] = {"reward_terms": result.reward_terms, "nonfinite": diverged}
@@ -191,9 +177,9 @@ class RotoEnv:
         if any_done:
             info["final_obs"] = obs
             info["_final_obs"] = done
-            info["episode"] = self._episode_info(truncated)
+            info["episode"] = self.episodes.info(truncated, self.task.metrics(self.task_state))
             info["_episode"] = done
-            self._nonfinite_resets += diverged.sum()  # stays on the device until someone reads it
+            self.episodes.nonfinite_resets += diverged.sum()  # stays on the device until someone reads it
             self._stack.reset_where(self._reset_where(done), done)
             obs = self._stack.observation()
         self._since_check += 1
@@ -212,14 +198,11 @@ class RotoEnv:
             "physics": torch.from_numpy(self.backend.physics_state()),
             "task": {f.name: getattr(self.task_state, f.name).clone() for f in dataclasses.fields(self.task_state)},
             "frames": self._stack.state_dict(),
-            "episode_length": self._episode.length.clone(),
-            "episode_return": self._episode.ret.clone(),
-            "term_sums": {name: value.clone() for name, value in self._term_sums.items()},
-            "target": self._target.clone(),
-            "last_action": self._last_action.clone(),
+            **self.episodes.state_dict(),
+            "target": self.joint_targets.clone(),
+            "last_action": self.last_action.clone(),
             "generator": self._generator.get_state(),
             "starts": self._starts.state_dict(),
-            "nonfinite_resets": self.nonfinite_resets,
             "needs_reset": self._needs_reset,
             "since_check": self._since_check,
             **{aid.state_key: aid.state_dict() for aid in self.aids if aid.state_key},
@@ -231,11 +214,9 @@ class RotoEnv:
         for name, value in state["task"].items():
             setattr(self.task_state, name, value.clone().to(self.device))
         self._stack.load_state_dict({name: value.to(self.device) for name, value in state["frames"].items()})
-        self._episode.length = state["episode_length"].clone().to(self.device)
-        self._episode.ret = state["episode_return"].clone().to(self.device)
-        self._term_sums = {name: value.clone().to(self.device) for name, value in state["term_sums"].items()}
-        self._target = state["target"].clone().to(self.device)
-        self._last_action = state["last_action"].clone().to(self.device)
+        self.episodes.load_state_dict(state, self.device)
+        self.joint_targets = state["target"].clone().to(self.device)
+        self.last_action = state["last_action"].clone().to(self.device)
         self._generator.set_state(state["generator"].cpu())
         if "starts" in state:
             self._starts.load_state_dict(state["starts"], self.device)
@@ -244,7 +225,6 @@ class RotoEnv:
         for aid in self.aids:
             if aid.state_key in state:
                 aid.load_state_dict(state[aid.state_key])
-        self._nonfinite_resets.fill_(int(state["nonfinite_resets"]))
         self._needs_reset = bool(state["needs_reset"])
         if "starts" in state and "since_check" in state:  # the pool as saved covers the steps until the next
             self._since_check = int(state["since_check"])  # check, as it did in the env that saved it
@@ -265,11 +245,11 @@ class RotoEnv:
     @property
     def nonfinite_resets(self) -> int:
         """Worlds reset so far because their physics went non-finite (reading it waits for the device)."""
-        return int(self._nonfinite_resets)
+        return int(self.episodes.nonfinite_resets)
 
     def hold_action(self) -> torch.Tensor:
         """(1, num_actions) float32 action whose joint targets are the default (cupped) pose."""
-        idx = self._idx
+        idx = self.indices
         return target_to_action(idx.act_qpos.take(idx.default_qpos), idx.ctrl_lo, idx.ctrl_hi).to(torch.float32)
 
     @property
@@ -329,7 +309,7 @@ class RotoEnv:
         self, selected: Selected, target: torch.Tensor, last_action: torch.Tensor, task: torch.Tensor | None
     ) -> dict[str, torch.Tensor]:
         """The env's groups of one frame (``roto.envs.frames.observation_frame``)."""
-        idx = self._idx
+        idx = self.indices
         return observation_frame(self.groups, self.config, selected, idx.obs_lo, idx.obs_hi, target, last_action, task)
 
     def _task_state_frame(self, state: object = None, length: torch.Tensor | None = None) -> torch.Tensor | None:
@@ -338,7 +318,7 @@ class RotoEnv:
         if "task" not in self.groups:
             return None
         state = self.task_state if state is None else state
-        length = self._episode.length if length is None else length
+        length = self.episodes.length if length is None else length
         return task_frame(self.task.observation(state), length, self.config.episode_steps)
 
     def _reset_where(self, done: torch.Tensor) -> dict[str, torch.Tensor]:
@@ -353,12 +333,9 @@ class RotoEnv:
             field = getattr(self.task_state, name)
             where = done.view(-1, *[1] * (field.dim() - 1))
             setattr(self.task_state, name, torch.where(where, start[f"task/{name}"].to(field.dtype), field))
-        self._target = torch.where(rows, start["target"], self._target)
-        self._last_action.masked_fill_(rows, 0.0)
-        self._episode.length.masked_fill_(done, 0)
-        self._episode.ret.masked_fill_(done, 0.0)
-        for value in self._term_sums.values():
-            value.masked_fill_(done, 0.0)
+        self.joint_targets = torch.where(rows, start["target"], self.joint_targets)
+        self.last_action.masked_fill_(rows, 0.0)
+        self.episodes.clear(done)
         return {name: start[f"frame/{name}"] for name in self.groups}
 
     def _draw_starts(self, n: int) -> dict[str, torch.Tensor]:
@@ -379,13 +356,3 @@ class RotoEnv:
         """n candidate starts (``roto.envs.start_draw.draw_candidates``), drawn from ``generator``
         (default: the env's)."""
         return draw_candidates(self, n, generator or self._generator)
-
-    def _episode_info(self, truncated: torch.Tensor) -> dict[str, torch.Tensor]:
-        info = {
-            "r": self._episode.ret.to(torch.float32, copy=True),
-            "l": self._episode.length.clone(),
-            "time_out": truncated.clone(),
-        }
-        info.update({k: v.clone() for k, v in self.task.metrics(self.task_state).items()})
-        info.update({f"reward/{k}": v.to(torch.float32, copy=True) for k, v in self._term_sums.items()})
-        return info

@@ -38,7 +38,7 @@ def supports_single_world_step(env: RotoEnv) -> bool:
     touch, no ``task`` group (and each ball's centre and velocity evenly spaced in qpos and qvel, as
     MuJoCo lays out free joints)."""
     cpu = env.device.type == "cpu" and isinstance(env.backend, MujocoCpuBackend) and not env.sync_free_step
-    balls_as_views = env._idx.ball_pos.start is not None and env._idx.ball_vel.start is not None
+    balls_as_views = env.indices.ball_pos.start is not None and env.indices.ball_vel.start is not None
     plain = env.config.touch == "binary" and "task" not in env.groups
     return cpu and env.num_envs == 1 and balls_as_views and plain
 
@@ -104,7 +104,7 @@ class SingleWorldStep:
                 f"device={env.device}, backend={type(env.backend).__name__}, touch={env.config.touch!r}"
             )
         self.env = env
-        idx, backend = env._idx, env.backend
+        idx, backend = env.indices, env.backend
         qpos, qvel, sensors = backend.qpos, backend.qvel, backend.sensordata
         now = sensors[:, -1]
         self._obs_qpos = _Reader(idx.obs_qpos, qpos)
@@ -143,9 +143,9 @@ class SingleWorldStep:
         diverged = bool(env.backend.step_array(target)[0])
         terms, terminated = self._task_step()
         reward = 0.0 if diverged else functools.reduce(operator.add, terms.values())
-        length = self._views.of("length", env._episode.length)
+        length = self._views.of("length", env.episodes.length)
         length += 1
-        self._views.of("return", env._episode.ret)[0] += reward
+        self._views.of("return", env.episodes.ret)[0] += reward
         terminated = diverged or terminated
         truncated = not terminated and int(length[0]) >= self._episode_steps
         obs = self._push_frame(target, last_action)
@@ -160,10 +160,10 @@ class SingleWorldStep:
         clamped = np.minimum(np.maximum(row.astype(np.float64), -1.0), 1.0)
         target = self._ctrl_lo + (clamped + 1.0) * 0.5 * self._ctrl_span
         if self._alpha != 1.0:
-            target = self._alpha * target + (1.0 - self._alpha) * self._views.of("target", env._target)
+            target = self._alpha * target + (1.0 - self._alpha) * self._views.of("target", env.joint_targets)
         # written into the env's own tensors (a new tensor a step costs more than the copy)
-        self._views.of("target", env._target)[...] = target
-        last_action = self._views.of("last_action", env._last_action)
+        self._views.of("target", env.joint_targets)[...] = target
+        last_action = self._views.of("last_action", env.last_action)
         last_action[...] = row
         return target, last_action
 
@@ -187,10 +187,10 @@ class SingleWorldStep:
         terms = {}
         for name, value in result.reward_terms.items():
             terms[name] = term = float(value[0])
-            if name in env._term_sums:
-                self._views.of(f"sum/{name}", env._term_sums[name])[0] += term
+            if name in env.episodes.term_sums:
+                self._views.of(f"sum/{name}", env.episodes.term_sums[name])[0] += term
             else:
-                env._term_sums[name] = torch.from_numpy(value.copy())
+                env.episodes.term_sums[name] = torch.from_numpy(value.copy())
         return terms, bool(result.terminated[0])
 
     def _push_frame(self, target: np.ndarray, last_action: np.ndarray) -> dict[str, np.ndarray]:
@@ -225,9 +225,10 @@ class SingleWorldStep:
         """Start the next episode with the env's own reset; the ended episode's statistics."""
         env = self.env
         env._starts.ensure(1)
-        episode = {k: v.item() for k, v in env._episode_info(torch.tensor([truncated])).items()}
+        ended = env.episodes.info(torch.tensor([truncated]), env.task.metrics(env.task_state))
+        episode = {k: v.item() for k, v in ended.items()}
         if diverged:
-            env._nonfinite_resets += 1
+            env.episodes.nonfinite_resets += 1
         env._stack.reset_where(env._reset_where(self._done), self._done)
         return episode
 

@@ -53,7 +53,7 @@ def draw_candidates(env: RotoEnv, n: int, generator: torch.Generator) -> dict[st
     frame ("frame/<group>"), and the depth (m) of the hand's deepest self-contact ("penetration",
     (n,)) and of the balls' deepest contact with the hand or each other ("ball_penetration", (n,)).
     Random draws come from ``generator``."""
-    idx, device = env._idx, env.device
+    idx, device = env.indices, env.device
     qpos = idx.default_qpos.expand(n, -1).clone()
     noise = uniform(generator, (n, env.num_actions), env.config.reset_joint_noise, device)
     idx.act_qpos.put(qpos, torch.clamp(idx.act_qpos.take(qpos) + noise, idx.ctrl_lo, idx.ctrl_hi))

@@ -111,8 +111,8 @@ class TactileFrameRenderer:
         """(per tactile link its touch value, per taxel whether it is pressed) after ``mj_forward``,
         read as the env reads them (``tactile_frame`` of the env's sensor columns)."""
         env, sensors = self.env, torch.from_numpy(self.data.sensordata)[None]
-        links = env._idx.tactile_force.take(sensors)
-        values = tactile_frame(env.config.touch, links, env._idx.taxels.take(sensors), env.config.tactile_threshold)
+        links = env.indices.tactile_force.take(sensors)
+        values = tactile_frame(env.config.touch, links, env.indices.taxels.take(sensors), env.config.tactile_threshold)
         n_links = len(env.robot.tactile_links)
         return values[0, :n_links].numpy(), values[0, n_links:].numpy() > 0
 

@@ -69,7 +69,7 @@ class BaodingReference:
 
     def start(self) -> None:
         """Plan afresh from the env's current state, first holding its current joint targets."""
-        self.planner.reset(self.env._target[0].numpy())
+        self.planner.reset(self.env.joint_targets[0].numpy())
 
     def act(self) -> torch.Tensor:
         """The (1, n) action of the cheapest plan from the env's current physics and task state."""
@@ -83,7 +83,7 @@ class BaodingReference:
             weights=self.weights,
         )
         joint_target = self.planner.plan(env.backend.physics_state()[0], cost)
-        return target_to_action(torch.from_numpy(joint_target)[None], env._idx.ctrl_lo, env._idx.ctrl_hi)
+        return target_to_action(torch.from_numpy(joint_target)[None], env.indices.ctrl_lo, env.indices.ctrl_hi)
 
 
 def run_reference_episode(
@@ -105,7 +105,7 @@ def run_reference_episode(
         history.append(
             (
                 env.backend.physics_state()[0],
-                env._target[0].numpy().copy(),
+                env.joint_targets[0].numpy().copy(),
                 bool(env.task_state.swapped[0]),
                 env.task_state.latched[0].numpy().copy(),
             )
@@ -189,7 +189,7 @@ def run_reference_baoding(
     sampling = sampling or SamplingConfig(seed=seed, threads=threads)
     weights = weights or BaodingCostWeights()
     env = reference_env(robot, seed)
-    planner = PredictiveSampling(env.model, env._idx.ctrl_lo.numpy(), env._idx.ctrl_hi.numpy(), sampling)
+    planner = PredictiveSampling(env.model, env.indices.ctrl_lo.numpy(), env.indices.ctrl_hi.numpy(), sampling)
     controller = BaodingReference(env, planner, weights)
     preswap = PreswapStates()
     per_episode = []

@@ -13,7 +13,7 @@ def test_time_out_truncates_at_episode_steps_and_resets_in_the_same_step():
         assert not terminated.any()
         assert truncated.all() == (step == 30) and truncated.any() == (step == 30)
     assert info["episode"]["time_out"].all() and info["episode"]["l"].tolist() == [30, 30]
-    assert env._episode.length.tolist() == [0, 0]  # already reset within the step
+    assert env.episodes.length.tolist() == [0, 0]  # already reset within the step
     env.close()
 
 
@@ -23,7 +23,7 @@ def test_episode_info_and_final_obs_on_termination():
     # move every ball far below the palm: all three terminate on the next step
     state = env.backend.state
     qpos = torch.from_numpy(env.backend.qpos.copy())
-    qpos[:, env._idx.ball_pos.index[0, 2]] = -0.5
+    qpos[:, env.indices.ball_pos.index[0, 2]] = -0.5
     env.backend.set_state(torch.arange(3), qpos, torch.zeros(3, env.model.nv))
     obs, _, terminated, truncated, info = env.step(torch.zeros(3, 20))
     assert terminated.all() and not truncated.any()

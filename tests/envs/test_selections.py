@@ -16,7 +16,7 @@ def test_cached_selections_read_each_steps_state(task, robot):
     first = None
     for _ in range(40):
         action = torch.rand(3, env.num_actions, generator=gen, dtype=torch.float64) * 2 - 1
-        sim = env.backend.step(action * 0.2 + env._target)
+        sim = env.backend.step(action * 0.2 + env.joint_targets)
         cached = env._selections.of(sim)
         reference = env._selections.select(sim.qpos.clone(), sim.qvel.clone(), sim.sensordata.clone())
         for name, got, want in zip(Selected._fields, cached, reference, strict=True):
@@ -37,7 +37,7 @@ def test_cached_selections_read_each_steps_state(task, robot):
 def test_taxel_selections_are_cached_views_too():
     env = make("bounce", robot="allegro", num_envs=2, seed=0, touch="taxels")
     env.reset(seed=0)
-    sims = [env.backend.step(env._target) for _ in range(3)]
+    sims = [env.backend.step(env.joint_targets) for _ in range(3)]
     selected = [env._selections.of(sim) for sim in sims]
     reference = env._selections.select(sims[-1].qpos.clone(), sims[-1].qvel.clone(), sims[-1].sensordata.clone())
     assert torch.equal(selected[-1].taxel_force, reference.taxel_force)
@@ -48,7 +48,7 @@ def test_taxel_selections_are_cached_views_too():
 def test_a_backend_that_copies_gets_fresh_selections_each_step():
     env = make("bounce", robot="shadow", num_envs=2, seed=0)
     env.reset(seed=0)
-    sim = env.backend.step(env._target)
+    sim = env.backend.step(env.joint_targets)
     float32_sim = type(sim)(sim.qpos.float(), sim.qvel.float(), sim.sensordata.float(), sim.diverged)
     env._selections.cache = None
     env._selections.of(float32_sim)

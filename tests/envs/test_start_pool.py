@@ -59,7 +59,7 @@ def first_frame_from_world(env, world: int) -> dict[str, torch.Tensor]:
     """The slow reference: the reset world's first frame rebuilt from the backend's state of it."""
     qpos = torch.from_numpy(env.backend.qpos[world : world + 1].copy())
     qvel = torch.from_numpy(env.backend.qvel[world : world + 1].copy())
-    target = env._target[world : world + 1]
+    target = env.joint_targets[world : world + 1]
     sensors = env.backend.sensors_at(qpos, qvel, target).to(torch.float64)
     selected = env._selections.select(qpos, qvel, sensors[:, None])
     task = env._task_state_frame()[world : world + 1]  # the world's task state, cleared by its reset

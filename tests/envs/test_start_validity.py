@@ -87,7 +87,7 @@ def test_the_ball_check_rejects_a_ball_started_in_the_hand():
     rest = torch.tensor(env.robot.baoding_targets[0], dtype=torch.float64)  # where ball a rests on the hand
     qpos[:, env.layout.ball_qpos[0] : env.layout.ball_qpos[0] + 3] = rest - torch.tensor([0.0, 0.0, 0.015])
     sensors = env.backend.sensors_at(qpos, torch.zeros(8, env.model.nv, dtype=torch.float64), candidates["target"])
-    found, dist = env._idx.ball_clearance.take(sensors.to(torch.float64)).unbind(-1)
+    found, dist = env.indices.ball_clearance.take(sensors.to(torch.float64)).unbind(-1)
     measured = torch.where(found > 0, -dist, 0.0).amax(dim=1)
     reference = torch.tensor([deepest_ball_contact(env.model, q.numpy()) for q in qpos], dtype=torch.float64)
     assert float(reference.min()) > 0.005  # 15 mm lower than where it rests: well inside the hand

@@ -60,7 +60,7 @@ def test_sync_free_step_has_a_start_for_every_world_ending_on_every_step():
     starts = []
     for _ in range(7):
         qpos = torch.from_numpy(env.backend.qpos.copy())
-        qpos[:, env._idx.ball_pos.index[0, 2]] = -0.5  # every ball far below the palm: every world ends
+        qpos[:, env.indices.ball_pos.index[0, 2]] = -0.5  # every ball far below the palm: every world ends
         env.backend.set_state(torch.arange(3), qpos, torch.zeros(3, env.model.nv))
         _, _, terminated, _, _ = env.step(torch.zeros(3, env.num_actions))
         assert terminated.all()

@@ -24,7 +24,7 @@ PRESWAP = pathlib.Path(__file__).resolve().parents[2] / "benchmarks/results/baod
 
 
 def controller_for(env, seed: int = 0) -> BaodingReference:
-    lo, hi = env._idx.ctrl_lo.numpy(), env._idx.ctrl_hi.numpy()
+    lo, hi = env.indices.ctrl_lo.numpy(), env.indices.ctrl_hi.numpy()
     planner = PredictiveSampling(env.model, lo, hi, SamplingConfig(threads=1, seed=seed))
     return BaodingReference(env, planner, BaodingCostWeights())
 

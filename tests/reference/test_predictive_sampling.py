@@ -56,13 +56,13 @@ def env():
 
 
 def planner_for(env, **kwargs) -> PredictiveSampling:
-    lo, hi = env._idx.ctrl_lo.numpy(), env._idx.ctrl_hi.numpy()
+    lo, hi = env.indices.ctrl_lo.numpy(), env.indices.ctrl_hi.numpy()
     return PredictiveSampling(env.model, lo, hi, SamplingConfig(threads=1, **kwargs))
 
 
 def test_the_plan_is_the_cheapest_sample_within_the_joint_limits(env):
     planner = planner_for(env, samples=16, horizon=6, knots=2)
-    hold = env._target[0].numpy()
+    hold = env.joint_targets[0].numpy()
     planner.reset(hold)
     j = int(np.argmax(np.minimum(planner.hi - hold, hold - planner.lo)))  # a joint with room both ways
     seen = []
@@ -81,7 +81,7 @@ def test_the_plan_is_the_cheapest_sample_within_the_joint_limits(env):
 def test_a_rollout_predicts_the_env_s_next_state(env):
     """The first control step of the nominal plan (hold) is the env's own next physics state."""
     planner = planner_for(env, samples=1, horizon=5, knots=2)
-    planner.reset(env._target[0].numpy())
+    planner.reset(env.joint_targets[0].numpy())
     predicted = []
 
     def cost(states, targets):
@@ -89,7 +89,7 @@ def test_a_rollout_predicts_the_env_s_next_state(env):
         return np.zeros(len(states))
 
     target = planner.plan(env.backend.physics_state()[0], cost)
-    action = target_to_action(torch.from_numpy(target)[None], env._idx.ctrl_lo, env._idx.ctrl_hi)
+    action = target_to_action(torch.from_numpy(target)[None], env.indices.ctrl_lo, env.indices.ctrl_hi)
     env.step(action)
     np.testing.assert_allclose(env.backend.physics_state()[0], predicted[0], atol=1e-6)
     planner.close()

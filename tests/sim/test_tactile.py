@@ -40,7 +40,7 @@ def test_bits_clear_within_one_step_after_the_ball_leaves(name):
     assert obs["tactile"][0, -n_links:].sum() > 0
     # lift both balls 30 cm above the hand
     qpos = torch.from_numpy(env.backend.qpos.copy())
-    qpos[0, env._idx.ball_pos.index[:, 2]] = 0.3
+    qpos[0, env.indices.ball_pos.index[:, 2]] = 0.3
     env.backend.set_state(torch.tensor([0]), qpos, torch.zeros(1, env.model.nv))
     obs, *_ = env.step(hold)
     assert obs["tactile"][0, -n_links:].sum() == 0

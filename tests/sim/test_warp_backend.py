@@ -162,7 +162,7 @@ def held_baoding_tactile(name: str, touch: str = "binary", steps: int = 20):
 @pytest.mark.parametrize("name", ["allegro", "shadow"])
 def test_held_baoding_balls_and_their_lift_read_the_same_on_both_backends(name):
     envs, tactile = held_baoding_tactile(name)
-    idx = envs[0]._idx
+    idx = envs[0].indices
     hold = envs[0].hold_action()
     for step_cpu, step_warp in zip(*tactile, strict=True):
         assert torch.equal(step_cpu, step_warp)

@@ -104,7 +104,7 @@ def own_bank(path):
 
     env = roto.make("bounce", robot="shadow", num_envs=4, seed=0)
     env.reset()
-    np.savez(path, physics=env.backend.physics_state(), target=env._target.numpy(), robot="shadow")
+    np.savez(path, physics=env.backend.physics_state(), target=env.joint_targets.numpy(), robot="shadow")
     env.close()
     return str(path)
 
