@@ -86,3 +86,39 @@ def test_training_aids_know_their_env_only_through_the_protocol():
     wrong = [f"{p.relative_to(ROOT)} imports {m}" for p in paths for m in imported_modules(p) if "roto_env" in m]
     wrong += [read for path in paths for read in private_reads(path)]
     assert not wrong, wrong
+
+
+def module_name(path: pathlib.Path) -> str:
+    return ".".join(path.relative_to(ROOT).with_suffix("").parts).removesuffix(".__init__")
+
+
+def import_circles(package: str) -> list[list[str]]:
+    """The circles in the import graph of ``package``'s modules (imports under ``TYPE_CHECKING``
+    count: they tie the files together as much)."""
+    paths = sorted((ROOT / package.replace(".", "/")).rglob("*.py"))
+    modules = {module_name(path): path for path in paths}
+    edges = {name: {m for m in imported_modules(path) if m in modules and m != name} for name, path in modules.items()}
+    circles, done = [], set()
+
+    def visit(name: str, trail: list[str]) -> None:
+        if name in trail:
+            circles.append([*trail[trail.index(name) :], name])
+            return
+        if name in done:
+            return
+        for other in sorted(edges[name]):
+            visit(other, [*trail, name])
+        done.add(name)
+
+    for name in sorted(modules):
+        visit(name, [])
+    return circles
+
+
+def test_the_envs_have_no_import_circle_and_no_private_reads_across_files():
+    """RotoEnv is composed of parts with public interfaces: no module of roto/envs imports one that
+    imports it back, and none reads another object's private state."""
+    assert len(list((ROOT / "roto" / "envs").rglob("*.py"))) > 20
+    assert import_circles("roto.envs") == []
+    reads = [read for path in sorted((ROOT / "roto" / "envs").rglob("*.py")) for read in private_reads(path)]
+    assert reads == []

@@ -161,6 +161,12 @@ class FrameStack:
         self.k = k
         self._frames: dict[str, torch.Tensor] = {}
 
+    @property
+    def frames(self) -> dict[str, torch.Tensor]:
+        """The stacked frames themselves, (B, k·dim) per group: the tensors the stack holds now (a
+        step replaces them; ``roto.envs.single_world`` writes its newest frame into them in place)."""
+        return self._frames
+
     def reset(self, frame: dict[str, torch.Tensor], env_ids: torch.Tensor | None = None) -> None:
         """Fill the stack of ``env_ids`` (all if None) with k copies of ``frame`` ((n, dim) per group)."""
         for name, value in frame.items():

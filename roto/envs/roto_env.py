@@ -80,7 +80,7 @@ class RotoEnv:
         self.indices = SceneIndices.from_layout(self.layout, self.robot, self.model, self.device, config.touch)
         self.num_actions = self.robot.num_actions
         self.task_state = self.task.init_state(self.robot, self.num_envs, self.device)
-        self._stack = FrameStack(config.frame_stack)
+        self.stack = FrameStack(config.frame_stack)
         self.episodes = EpisodeBook.empty(self.num_envs, self.device)
         self.joint_targets = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float64, device=self.device)
         self.last_action = torch.zeros(self.num_envs, self.num_actions, dtype=torch.float32, device=self.device)
@@ -90,7 +90,7 @@ class RotoEnv:
         self._start_task_fields = tuple(name for aid in self.aids for name in aid.start_task_fields())
         self._watching_aids = tuple(aid for aid in self.aids if aid.watches_steps)
         self._starts = StartPool(self._draw_starts, size=self.num_envs, device=self.device)
-        self._selections = Selections(self.indices, self.device, taxels=config.touch == "taxels")
+        self.selections = Selections(self.indices, self.device, taxels=config.touch == "taxels")
         # reading the device is free on the CPU and waits for a GPU. A sync-free step reads nothing:
         # resets run masked every step, and the pool of starts and the action check are read every
         # `check_every` steps, the pool holding enough starts for every world to reset on each of
@@ -125,11 +125,11 @@ class RotoEnv:
         if self.sync_free_step:  # read only every check_every steps: cover every world ending on each of them
             with deliberate_host_sync(self.device):
                 self._starts.ensure(self.check_every * self.num_envs)
-        self._stack.reset(frame)
+        self.stack.reset(frame)
         for aid in self.aids:
             aid.on_reset()
         self._needs_reset = False
-        return self._stack.observation(), {}
+        return self.stack.observation(), {}
 
     def step(
         self, action: torch.Tensor
@@ -148,7 +148,7 @@ class RotoEnv:
         self.last_action = action.to(torch.float32, copy=True)  # never alias the caller's tensor
 
         sim = self.backend.step(self.joint_targets)
-        selected = self._selections.of(sim)
+        selected = self.selections.of(sim)
         diverged = sim.diverged.to(self.device)
 
         inputs = self._task_inputs(selected)
@@ -158,9 +158,9 @@ class RotoEnv:
         terminated = result.terminated | diverged
         truncated = (self.episodes.length >= self.config.episode_steps) & ~terminated
 
-        frame = self._frame(selected, self.joint_targets, self.last_action, self._task_state_frame())
-        self._stack.push(frame)
-        obs = self._stack.observation()
+        frame = self.observation_frame(selected, self.joint_targets, self.last_action, self.task_state_frame())
+        self.stack.push(frame)
+        obs = self.stack.observation()
 
         done = terminated | truncated
         if self._watching_aids:  # training aids fed by the headline metric, before the resets
@@ -180,8 +180,8 @@ class RotoEnv:
             info["episode"] = self.episodes.info(truncated, self.task.metrics(self.task_state))
             info["_episode"] = done
             self.episodes.nonfinite_resets += diverged.sum()  # stays on the device until someone reads it
-            self._stack.reset_where(self._reset_where(done), done)
-            obs = self._stack.observation()
+            self.stack.reset_where(self._reset_where(done), done)
+            obs = self.stack.observation()
         self._since_check += 1
         if self._since_check == self.check_every:
             self._periodic_check()
@@ -197,7 +197,7 @@ class RotoEnv:
         return {
             "physics": torch.from_numpy(self.backend.physics_state()),
             "task": {f.name: getattr(self.task_state, f.name).clone() for f in dataclasses.fields(self.task_state)},
-            "frames": self._stack.state_dict(),
+            "frames": self.stack.state_dict(),
             **self.episodes.state_dict(),
             "target": self.joint_targets.clone(),
             "last_action": self.last_action.clone(),
@@ -213,7 +213,7 @@ class RotoEnv:
         self.backend.load_physics_state(state["physics"].cpu().numpy())
         for name, value in state["task"].items():
             setattr(self.task_state, name, value.clone().to(self.device))
-        self._stack.load_state_dict({name: value.to(self.device) for name, value in state["frames"].items()})
+        self.stack.load_state_dict({name: value.to(self.device) for name, value in state["frames"].items()})
         self.episodes.load_state_dict(state, self.device)
         self.joint_targets = state["target"].clone().to(self.device)
         self.last_action = state["last_action"].clone().to(self.device)
@@ -241,6 +241,18 @@ class RotoEnv:
         """The training aids' scalars ("train/<name>" -> () tensor on the env's device; reading one
         waits for the device); empty without aids."""
         return {name: value for aid in self.aids for name, value in aid.metrics().items()}
+
+    @property
+    def needs_reset(self) -> bool:
+        """Whether ``reset`` must come before the next ``step``."""
+        return self._needs_reset
+
+    def restart_where(self, done: torch.Tensor, count: int) -> None:
+        """Start new episodes in the ``count`` worlds where ``done`` (B,) is True: starts taken
+        from the pool (drawn now where it runs short), frame stacks refilled with their first
+        frames. For a caller that steps the worlds itself (``roto.envs.single_world``)."""
+        self._starts.ensure(count)
+        self.stack.reset_where(self._reset_where(done), done)
 
     @property
     def nonfinite_resets(self) -> int:
@@ -305,14 +317,14 @@ class RotoEnv:
         contact = (selected.ball_force > self.config.tactile_threshold).any(dim=1)
         return TaskInputs(ball_pos=selected.ball_pos, ball_vel=selected.ball_vel, ball_contact=contact)
 
-    def _frame(
+    def observation_frame(
         self, selected: Selected, target: torch.Tensor, last_action: torch.Tensor, task: torch.Tensor | None
     ) -> dict[str, torch.Tensor]:
         """The env's groups of one frame (``roto.envs.frames.observation_frame``)."""
         idx = self.indices
         return observation_frame(self.groups, self.config, selected, idx.obs_lo, idx.obs_hi, target, last_action, task)
 
-    def _task_state_frame(self, state: object = None, length: torch.Tensor | None = None) -> torch.Tensor | None:
+    def task_state_frame(self, state: object = None, length: torch.Tensor | None = None) -> torch.Tensor | None:
         """The ``task`` group's frame of ``state`` (default: the env's task state) after ``length``
         (B,) steps (default: the episodes' lengths); None when the env returns no task group."""
         if "task" not in self.groups:

@@ -137,7 +137,7 @@ class SingleWorldStep:
         env = self.env
         array = np.asarray(action)
         unusual = array.dtype.kind != "f" or array.size != self._num_actions or not _all_finite(array)
-        if env._needs_reset or unusual:
+        if env.needs_reset or unusual:
             return self._reference_step(array)  # raises the env's own error
         target, last_action = self._set_action(array.reshape(1, -1))
         diverged = bool(env.backend.step_array(target)[0])
@@ -196,7 +196,7 @@ class SingleWorldStep:
     def _push_frame(self, target: np.ndarray, last_action: np.ndarray) -> dict[str, np.ndarray]:
         """Push this step's frame onto the env's stack in place (the oldest frame out, this
         step's frame written straight into the newest slot); the observation (copies)."""
-        stack = self.env._stack._frames
+        stack = self.env.stack.frames
         obs = {}
         for name in self.env.groups:
             frames = self._views.of(f"stack/{name}", stack[name])
@@ -224,12 +224,11 @@ class SingleWorldStep:
     def _reset(self, truncated: bool, diverged: bool) -> dict[str, Any]:
         """Start the next episode with the env's own reset; the ended episode's statistics."""
         env = self.env
-        env._starts.ensure(1)
         ended = env.episodes.info(torch.tensor([truncated]), env.task.metrics(env.task_state))
         episode = {k: v.item() for k, v in ended.items()}
         if diverged:
             env.episodes.nonfinite_resets += 1
-        env._stack.reset_where(env._reset_where(self._done), self._done)
+        env.restart_where(self._done, 1)
         return episode
 
     def _reference_step(self, array: np.ndarray) -> SingleStep:

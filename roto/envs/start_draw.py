@@ -1,4 +1,5 @@
-"""Episode starts of a ``RotoEnv``: the task's own, and the first frame of any start.
+"""Episode starts of an env (``StartSource``: ``RotoEnv``'s public parts): the task's own, and the
+first frame of any start.
 
 The task's own start is the hand at its default pose plus joint noise with the task's balls
 placed, at rest, redrawn until valid (``roto.envs.start_pool.draw_valid_starts``); training aids
@@ -8,18 +9,43 @@ may start episodes elsewhere (``roto.envs.aids``).
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
+import mujoco
 import torch
 
+from roto.envs.config import EnvConfig
+from roto.envs.indices import SceneIndices
+from roto.envs.selections import Selected, Selections
 from roto.envs.start_pool import contact_depth, draw_valid_starts
-from roto.tasks.base import uniform
+from roto.robots.spec import RobotSpec
+from roto.sim.backend import Backend
+from roto.tasks.base import Task, uniform
 
-if TYPE_CHECKING:
-    from roto.envs.roto_env import RotoEnv
+
+class StartSource(Protocol):
+    """What drawing starts reads of an env (``RotoEnv`` is one): its public parts."""
+
+    backend: Backend
+    config: EnvConfig
+    device: torch.device
+    groups: tuple[str, ...]
+    indices: SceneIndices
+    model: mujoco.MjModel
+    num_actions: int
+    robot: RobotSpec
+    selections: Selections
+    task: Task
+    task_state: Any
+
+    def observation_frame(
+        self, selected: Selected, target: torch.Tensor, last_action: torch.Tensor, task: torch.Tensor | None
+    ) -> dict[str, torch.Tensor]: ...
+
+    def task_state_frame(self, state: object = None, length: torch.Tensor | None = None) -> torch.Tensor | None: ...
 
 
-def draw_starts(env: RotoEnv, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
+def draw_starts(env: StartSource, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
     """n valid episode starts of the task's own (``draw_candidates``, redrawn until valid): rows as
     ``draw_candidates``' without the depths. A training aid may draw others instead
     (``roto.envs.aids.TrainingAid.draw_starts``)."""
@@ -27,7 +53,7 @@ def draw_starts(env: RotoEnv, n: int, generator: torch.Generator) -> dict[str, t
 
 
 def first_frame(
-    env: RotoEnv, qpos: torch.Tensor, qvel: torch.Tensor, target: torch.Tensor, task_rows: dict[str, torch.Tensor]
+    env: StartSource, qpos: torch.Tensor, qvel: torch.Tensor, target: torch.Tensor, task_rows: dict[str, torch.Tensor]
 ) -> tuple[dict[str, torch.Tensor], torch.Tensor]:
     """The first observation frame ("frame/<group>" -> (n, dim)) of n starts, and their sensor
     values (n, nsensordata); ``task_rows`` are the task state fields the starts begin with (the
@@ -35,19 +61,19 @@ def first_frame(
     device = env.device
     n = len(qpos)
     sensors = env.backend.sensors_at(qpos, qvel, target).to(device, torch.float64)
-    selected = env._selections.select(qpos, qvel, sensors[:, None])
+    selected = env.selections.select(qpos, qvel, sensors[:, None])
     last_action = torch.zeros(n, env.num_actions, dtype=torch.float32, device=device)
     task_frame = None
     if "task" in env.groups:
         first = env.task.init_state(env.robot, n, device)
         for name, rows in task_rows.items():
             setattr(first, name, rows.to(getattr(first, name).dtype))
-        task_frame = env._task_state_frame(first, torch.zeros(n, dtype=torch.int64, device=device))
-    frame = env._frame(selected, target, last_action, task_frame)
+        task_frame = env.task_state_frame(first, torch.zeros(n, dtype=torch.int64, device=device))
+    frame = env.observation_frame(selected, target, last_action, task_frame)
     return {f"frame/{name}": value for name, value in frame.items()}, sensors
 
 
-def draw_candidates(env: RotoEnv, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
+def draw_candidates(env: StartSource, n: int, generator: torch.Generator) -> dict[str, torch.Tensor]:
     """n candidates of the task's own starts: the hand at its default pose plus noise, the task's
     balls placed, at rest; their qpos (n, nq), qvel (n, nv, zero), joint targets (n, n_act), first
     frame ("frame/<group>"), and the depth (m) of the hand's deepest self-contact ("penetration",

@@ -17,8 +17,8 @@ def test_cached_selections_read_each_steps_state(task, robot):
     for _ in range(40):
         action = torch.rand(3, env.num_actions, generator=gen, dtype=torch.float64) * 2 - 1
         sim = env.backend.step(action * 0.2 + env.joint_targets)
-        cached = env._selections.of(sim)
-        reference = env._selections.select(sim.qpos.clone(), sim.qvel.clone(), sim.sensordata.clone())
+        cached = env.selections.of(sim)
+        reference = env.selections.select(sim.qpos.clone(), sim.qvel.clone(), sim.sensordata.clone())
         for name, got, want in zip(Selected._fields, cached, reference, strict=True):
             if name == "taxel_force":  # only with taxel touch
                 assert got is None and want is None
@@ -26,11 +26,11 @@ def test_cached_selections_read_each_steps_state(task, robot):
                 assert torch.equal(got, want), name
         first = first or cached
     # the views were made once and reused (only gathered columns are made again)
-    copies = env._selections.cache[4]
-    for i, name in enumerate(Selected._fields[: len(env._selections.table)]):
+    copies = env.selections.cache[4]
+    for i, name in enumerate(Selected._fields[: len(env.selections.table)]):
         if i not in copies:
             assert cached[i] is first[i], name
-    assert len(copies) < len(env._selections.table)
+    assert len(copies) < len(env.selections.table)
     env.close()
 
 
@@ -38,8 +38,8 @@ def test_taxel_selections_are_cached_views_too():
     env = make("bounce", robot="allegro", num_envs=2, seed=0, touch="taxels")
     env.reset(seed=0)
     sims = [env.backend.step(env.joint_targets) for _ in range(3)]
-    selected = [env._selections.of(sim) for sim in sims]
-    reference = env._selections.select(sims[-1].qpos.clone(), sims[-1].qvel.clone(), sims[-1].sensordata.clone())
+    selected = [env.selections.of(sim) for sim in sims]
+    reference = env.selections.select(sims[-1].qpos.clone(), sims[-1].qvel.clone(), sims[-1].sensordata.clone())
     assert torch.equal(selected[-1].taxel_force, reference.taxel_force)
     assert selected[-1].taxel_force is selected[1].taxel_force  # a view made once
     env.close()
@@ -50,7 +50,7 @@ def test_a_backend_that_copies_gets_fresh_selections_each_step():
     env.reset(seed=0)
     sim = env.backend.step(env.joint_targets)
     float32_sim = type(sim)(sim.qpos.float(), sim.qvel.float(), sim.sensordata.float(), sim.diverged)
-    env._selections.cache = None
-    env._selections.of(float32_sim)
-    assert env._selections.cache is None  # converted copies are never cached
+    env.selections.cache = None
+    env.selections.of(float32_sim)
+    assert env.selections.cache is None  # converted copies are never cached
     env.close()

@@ -61,9 +61,9 @@ def first_frame_from_world(env, world: int) -> dict[str, torch.Tensor]:
     qvel = torch.from_numpy(env.backend.qvel[world : world + 1].copy())
     target = env.joint_targets[world : world + 1]
     sensors = env.backend.sensors_at(qpos, qvel, target).to(torch.float64)
-    selected = env._selections.select(qpos, qvel, sensors[:, None])
-    task = env._task_state_frame()[world : world + 1]  # the world's task state, cleared by its reset
-    return env._frame(selected, target, torch.zeros(1, env.num_actions), task)
+    selected = env.selections.select(qpos, qvel, sensors[:, None])
+    task = env.task_state_frame()[world : world + 1]  # the world's task state, cleared by its reset
+    return env.observation_frame(selected, target, torch.zeros(1, env.num_actions), task)
 
 
 @pytest.mark.parametrize(("task", "robot"), list_envs())

@@ -31,7 +31,7 @@ def test_baoding_task_frame_holds_current_targets_latches_and_time_left():
     # the frame follows the assignment and the latches
     env.task_state.swapped[1] = True
     env.task_state.latched[1, 0] = True
-    frame = env._task_state_frame()
+    frame = env.task_state_frame()
     assert torch.equal(frame[1, :6], targets.flip(0).flatten()) and frame[1, 6:8].tolist() == [1.0, 0.0]
     assert torch.equal(frame[0, :6], targets.flatten()) and frame[0, 6:8].tolist() == [0.0, 0.0]
     env.close()
@@ -45,7 +45,7 @@ def test_bounce_task_frame_is_its_counter_state_in_unit_range():
     state.prev_contact[:] = torch.tensor([True, False])
     state.waiting[:] = torch.tensor([False, True])
     state.steps_without_contact[:] = torch.tensor([2, 40])
-    frame = env._task_state_frame()
+    frame = env.task_state_frame()
     torch.testing.assert_close(frame[:, :3], torch.tensor([[1.0, 0.0, 0.4], [0.0, 1.0, 1.0]]))
     env.close()
 
