@@ -28,6 +28,7 @@ from roto.olympiad.plan import Cell, Plan
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import checkpoint_path
 from roto.sweep.claims import run_claimed, tell_failed
+from roto.sweep.optuna_ids import storage_id
 from roto.sweep.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 
 CELL_ATTR = "cell"
@@ -92,8 +93,8 @@ def claim_next(
 
     for trial in sorted(waiting, key=order):
         try:
-            if storage.set_trial_state_values(trial._trial_id, TrialState.RUNNING):
-                return optuna.Trial(study, trial._trial_id)
+            if storage.set_trial_state_values(storage_id(trial), TrialState.RUNNING):
+                return optuna.Trial(study, storage_id(trial))
         except UpdateFinishedTrialError:  # another worker claimed and finished it meanwhile
             continue
     return None

@@ -116,7 +116,7 @@ class RolloutThreads:
             self._todo[k].put(True)
         errors: list[BaseException] = []
         try:
-            self._work(0)
+            self.work(0)
         except BaseException as error:  # re-raised below, once the helpers stop
             errors.append(error)
             with self._lock:
@@ -155,7 +155,7 @@ class RolloutThreads:
         for helper in self._helpers:
             helper.start()
 
-    def _work(self, thread: int) -> None:
+    def work(self, thread: int) -> None:
         """Take chunks of the current job until none is left, stepping them on ``thread``'s data."""
         state0, ctrl, state, sensordata = self._job
         ends = self._chunk_ends
@@ -193,7 +193,7 @@ def _helper_loop(pool_ref: weakref.ref, thread: int, todo: queue.SimpleQueue, do
         if pool is None:
             return
         try:
-            pool._work(thread)
+            pool.work(thread)
         except BaseException as error:  # handed to the caller's run()
             done.put(error)
         else:

@@ -20,6 +20,7 @@ from optuna.exceptions import UpdateFinishedTrialError
 from optuna.trial import TrialState
 
 from roto.rl.stop_requests import signal_handlers
+from roto.sweep.optuna_ids import storage_id
 from roto.sweep.storage import REASON_ATTR, Heartbeat, enqueue_retry
 
 
@@ -35,7 +36,7 @@ def run_claimed(
     Returns True when the outcome was told, False when another worker had declared the trial dead
     meanwhile (its retry then counts instead).
     """
-    trial_id = trial._trial_id  # the storage's id: heartbeats and system attributes are written by id
+    trial_id = storage_id(trial)  # the storage's id: heartbeats and system attributes are written by id
     start = time.perf_counter()
     state, value, reason = TrialState.COMPLETE, None, None
     try:
@@ -72,7 +73,7 @@ def fail_and_retry(study: optuna.Study, storage: optuna.storages.BaseStorage, tr
         tell_failed(study, trial, reason)
     except UpdateFinishedTrialError:
         return
-    enqueue_retry(study, storage.get_trial(trial._trial_id))
+    enqueue_retry(study, storage.get_trial(storage_id(trial)))
 
 
 def launch_workers(command: str, count: int, argv: Sequence[str]) -> int:

@@ -38,6 +38,7 @@ from optuna.storages.journal import JournalStorage
 from optuna.trial import TrialState
 
 from roto.sweep.journal import JournalFile
+from roto.sweep.optuna_ids import storage_id
 from roto.sweep.retrying_storage import RetryingStorage, first_line, permission_denied, permission_error
 
 JOURNAL_NAME = "journal.log"
@@ -322,12 +323,12 @@ def fail_stale_trials(
         if now - beat <= grace:
             continue
         try:
-            storage.set_trial_user_attr(trial._trial_id, REASON_ATTR, why or f"no heartbeat for {now - beat:.0f} s")
-            if not storage.set_trial_state_values(trial._trial_id, TrialState.FAIL):
+            storage.set_trial_user_attr(storage_id(trial), REASON_ATTR, why or f"no heartbeat for {now - beat:.0f} s")
+            if not storage.set_trial_state_values(storage_id(trial), TrialState.FAIL):
                 continue
         except UpdateFinishedTrialError:
             continue
-        enqueue_retry(study, storage.get_trial(trial._trial_id))
+        enqueue_retry(study, storage.get_trial(storage_id(trial)))
         failed.append(trial.number)
     return failed
 

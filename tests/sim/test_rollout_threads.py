@@ -169,13 +169,13 @@ def test_a_run_limited_to_one_thread_wakes_no_helper(batch, monkeypatch) -> None
     pool = RolloutThreads(model, 2, 1)
     try:
         used = set()
-        work = pool._work
+        work = pool.work
 
         def recording_work(thread: int) -> None:
             used.add(thread)
             work(thread)
 
-        monkeypatch.setattr(pool, "_work", recording_work)
+        monkeypatch.setattr(pool, "work", recording_work)
         pool.run(state0, ctrl, *_outputs(model, ctrl), nstep=3, threads=1)
         assert used == {0}
         pool.run(state0, ctrl, *_outputs(model, ctrl), nstep=3)
