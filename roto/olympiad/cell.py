@@ -96,12 +96,8 @@ def run_cell(
 ) -> dict[str, Any]:
     """Train (or continue) the cell, evaluate it, write and return its summary."""
     wait_until_free(run_dir)  # a retry of a cell whose first worker, declared dead, is still training it
-    trainer = Trainer.open(run_dir, cell_spec(plan, cell), env_factory=env_factory)
-    try:
+    with Trainer.open(run_dir, cell_spec(plan, cell), env_factory=env_factory) as trainer:
         trainer.train(progress=False)
-    finally:
-        trainer.env.close()
-        trainer.evaluator.env.close()
     final = copy.deepcopy(trainer.model).cpu().eval()
     best = copy.deepcopy(final)
     best.load_state_dict(load_checkpoint(RunDir(run_dir).checkpoint("best"))["model"])

@@ -25,7 +25,7 @@ from roto.rl.checkpoints import load_checkpoint, save_checkpoint
 from roto.rl.config import AgentConfig, to_dict
 from roto.rl.evaluation import PolicyEvaluator
 from roto.rl.logger import ScalarLogger
-from roto.rl.run_dir import CHECKPOINT_DIR, RunDir, first_missing, numbered_checkpoints
+from roto.rl.run_dir import CHECKPOINT_DIR, RunDir, checkpoint_path, first_missing, numbered_checkpoints
 from roto.rl.run_lock import hold_run_lock
 from roto.rl.run_spec import RunSpec
 from roto.rl.settings import TrainSettings, read_run_config, run_config, write_run_config
@@ -198,7 +198,7 @@ class Trainer:
     def _stop_after_update(self, signal_name: str | None) -> None:
         """A stop asked for by a signal (``roto.rl.stop_requests``): checkpoint this update, then stop."""
         if self.update % self.agent.run.checkpoint_every != 0:  # else ``_checkpoint`` has just written it
-            self.save(self.run_dir / CHECKPOINT_DIR / "latest.pt")
+            self.save(checkpoint_path(self.run_dir, "latest"))
         raise KeyboardInterrupt(f"{signal_name}: stopped after update {self.update}, which latest.pt holds")
 
     def _open_logger(self) -> ScalarLogger:
@@ -237,17 +237,17 @@ class Trainer:
         self.last_eval = {f"eval/{key}": value for key, value in summary.items()}
         if record["return_mean"] > self.best_eval_return:
             self.best_eval_return = record["return_mean"]
-            self.save(self.run_dir / CHECKPOINT_DIR / "best.pt", policy_only=True)
+            self.save(checkpoint_path(self.run_dir, "best"), policy_only=True)
         return {**self.last_eval, "perf/eval_s": record["eval_s"]}
 
     def _checkpoint(self) -> None:
         every = self.agent.run.checkpoint_every
         if self.update % every == 0 or self.update == self.total_updates:
-            self.save(self.run_dir / CHECKPOINT_DIR / "latest.pt")
+            self.save(checkpoint_path(self.run_dir, "latest"))
         keep = self.agent.run.keep_checkpoints
         if self.update % every == 0:
             if keep > 0:
-                self.save(self.run_dir / CHECKPOINT_DIR / f"agent_{self.update}.pt", policy_only=True)
+                self.save(checkpoint_path(self.run_dir, f"agent_{self.update}"), policy_only=True)
             for old in numbered_checkpoints(self.run_dir)[: -keep or None]:  # keep 0: every one goes
                 old.unlink()
 
@@ -286,6 +286,17 @@ class Trainer:
             "best_eval_return": self.best_eval_return,
             "last_eval": self.last_eval,
         }
+
+    def close(self) -> None:
+        """Release both env sets' backends (the training envs' and the evaluation envs')."""
+        self.env.close()
+        self.evaluator.env.close()
+
+    def __enter__(self) -> Trainer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     def save(self, path: pathlib.Path, policy_only: bool = False) -> None:
         """Write a checkpoint atomically: everything to resume from, or with ``policy_only`` the
@@ -363,7 +374,7 @@ class Trainer:
         """
         run_dir = pathlib.Path(run_dir)
         settings, agent = read_run_config(run_dir)
-        checkpoint = run_dir / CHECKPOINT_DIR / "latest.pt"
+        checkpoint = checkpoint_path(run_dir, "latest")
         if not checkpoint.is_file():
             raise FileNotFoundError(f"no checkpoint to resume from: {str(checkpoint)!r} does not exist")
         state = load_checkpoint(checkpoint)  # read before anything is built or written

@@ -105,20 +105,17 @@ def run_trial(
     trial.set_user_attr("seed", seed)
     trial.set_user_attr("run_dir", str(run_dir))
     wait_until_free(run_dir)  # a retry of a trial whose first worker, declared dead, is still training it
-    trainer = Trainer.open(run_dir, trial_spec(settings, params, seed), tensorboard=True, env_factory=env_factory)
-    headline = getattr(trainer.env.task, "headline_metric", None)
-    monitor = TrialMonitor(trial, lambda record: objective_value(record, settings.objective, headline))
-    for record in read_evaluations(run_dir):  # a retry: the earlier try's reports, on this trial
-        monitor.best = max(monitor.best, monitor.value(record))
-        trial.report(monitor.best, record["env_steps"])
-    try:
-        trainer.train(progress=False, on_update=monitor)
-    except (ValueError, RuntimeError) as error:
-        # non-finite weights make non-finite actions, which the env refuses before the hook sees them
-        if all(bool(torch.isfinite(p).all()) for p in trainer.model.parameters()):
-            raise
-        raise Diverged(f"non-finite weights at update {trainer.update}: {error}") from error
-    finally:
-        trainer.env.close()
-        trainer.evaluator.env.close()
+    with Trainer.open(run_dir, trial_spec(settings, params, seed), env_factory=env_factory) as trainer:
+        headline = getattr(trainer.env.task, "headline_metric", None)
+        monitor = TrialMonitor(trial, lambda record: objective_value(record, settings.objective, headline))
+        for record in read_evaluations(run_dir):  # a retry: the earlier try's reports, on this trial
+            monitor.best = max(monitor.best, monitor.value(record))
+            trial.report(monitor.best, record["env_steps"])
+        try:
+            trainer.train(progress=False, on_update=monitor)
+        except (ValueError, RuntimeError) as error:
+            # non-finite weights make non-finite actions, which the env refuses before the hook sees them
+            if all(bool(torch.isfinite(p).all()) for p in trainer.model.parameters()):
+                raise
+            raise Diverged(f"non-finite weights at update {trainer.update}: {error}") from error
     return max(monitor.value(record) for record in read_evaluations(run_dir))
