@@ -40,6 +40,7 @@ def test_no_function_is_over_60_lines():
 LAYERS = {
     "envs": ("roto.rl", "roto.eval", "roto.sweep", "roto.olympiad"),
     "rl": ("roto.eval", "roto.sweep", "roto.olympiad"),
+    "jobs": ("roto.envs", "roto.eval", "roto.sweep", "roto.olympiad"),
 }
 """Packages and what they must never import: data flows up, from the envs to the learner to what
 evaluates, sweeps and tabulates it."""

@@ -46,10 +46,10 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     """Run (or with --dry-run list) the plan's cells."""
     import torch
 
+    from roto.jobs.claims import launch_workers
+    from roto.jobs.storage import reclaim_now, resolve_storage, storage_in_environment
     from roto.olympiad.plan import load_plan
     from roto.olympiad.worker import enqueue_missing, open_olympiad, run_olympiad_worker
-    from roto.sweep.claims import launch_workers
-    from roto.sweep.storage import reclaim_now, resolve_storage, storage_in_environment
 
     args.storage = resolve_storage(args.storage)
     plan = load_plan(args.plan)  # checked before anything runs or is written

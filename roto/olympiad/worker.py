@@ -1,7 +1,7 @@
 """Olympiad workers: cells handed out through an Optuna study, on one machine or many.
 
 Each cell is a trial enqueued in the study ``olympiad-<plan>`` (the journal in ``<root>/<plan>``
-or a database, as for sweeps, ``roto.sweep.storage``), its name in the trial's ``cell`` user
+or a database, as for sweeps, ``roto.jobs.storage``), its name in the trial's ``cell`` user
 attribute. A worker enqueues every cell that has neither a summary nor a live trial, then claims
 waiting trials until none is waiting or running. A worker that dies leaves its trial without a
 heartbeat; the next worker to look fails it and enqueues a retry, which continues the cell's run
@@ -23,13 +23,13 @@ from optuna.exceptions import UpdateFinishedTrialError
 from optuna.trial import TrialState
 
 from roto.envs.roto_env import RotoEnv
+from roto.jobs.claims import run_claimed, tell_failed
+from roto.jobs.optuna_ids import storage_id
+from roto.jobs.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 from roto.olympiad.cell import code_commit, run_cell, summary_path
 from roto.olympiad.plan import Cell, Plan
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import checkpoint_path
-from roto.sweep.claims import run_claimed, tell_failed
-from roto.sweep.optuna_ids import storage_id
-from roto.sweep.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 
 CELL_ATTR = "cell"
 LIVE = (TrialState.COMPLETE, TrialState.RUNNING, TrialState.WAITING)
@@ -79,7 +79,7 @@ def claim_next(
     """Claim a waiting trial: retries and started cells before fresh ones, the most trained first,
     then by number; None when none waits. ``trained(cell name)``: the env steps its run has trained,
     None for a cell not started. A started cell's trial need not be a retry: Optuna's retries of one
-    trial run out after ``roto.sweep.storage.MAX_RETRY`` (3), and a cell reclaimed at the end of
+    trial run out after ``roto.jobs.storage.MAX_RETRY`` (3), and a cell reclaimed at the end of
     every sitting is then enqueued afresh, at the back of the queue.
 
     As ``optuna.Study.ask`` claims one, but in this order: setting a waiting trial running is

@@ -70,9 +70,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     """Run ``--workers`` workers on the study until it has its trials."""
     import torch
 
-    from roto.sweep.claims import launch_workers
+    from roto.jobs.claims import launch_workers
+    from roto.jobs.storage import reclaim_now, resolve_storage, storage_in_environment
     from roto.sweep.space import load_space
-    from roto.sweep.storage import reclaim_now, resolve_storage, storage_in_environment
     from roto.sweep.study import SweepSettings, enqueue_base, open_study
     from roto.sweep.worker import run_worker
 
@@ -121,8 +121,8 @@ def _worker_argv(args: argparse.Namespace) -> list[str]:
 
 def cmd_export(args: argparse.Namespace) -> int:
     """Write the best trial's agent config."""
+    from roto.jobs.storage import resolve_storage
     from roto.sweep.report import export_best
-    from roto.sweep.storage import resolve_storage
 
     print(json.dumps(export_best(args.study, args.root, resolve_storage(args.storage), args.out, args.trial)))
     return 0
@@ -130,8 +130,8 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Print the study's trials and importances."""
+    from roto.jobs.storage import resolve_storage
     from roto.sweep.report import show
-    from roto.sweep.storage import resolve_storage
 
     sys.stdout.write(show(args.study, args.root, resolve_storage(args.storage)) + "\n")
     return 0

@@ -11,8 +11,8 @@ from typing import Any
 import optuna
 
 from roto.envs.config import EnvConfig
+from roto.jobs.storage import JOURNAL_NAME, find_study, open_storage, redact_url
 from roto.sweep.pruner import MedianBestSoFarPruner
-from roto.sweep.storage import JOURNAL_NAME, find_study, open_storage, redact_url
 from roto.tasks import get_task
 
 STUDY_NAME = re.compile(r"[A-Za-z0-9._-]+")

@@ -21,12 +21,12 @@ import torch
 
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
+from roto.jobs.storage import RETRY_OF_ATTR
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_lock import wait_until_free
 from roto.rl.run_spec import RunSpec, build_run_spec
 from roto.rl.runner import Trainer
 from roto.sweep.space import SearchSpace, as_overrides
-from roto.sweep.storage import RETRY_OF_ATTR
 from roto.sweep.study import TIE_BREAK, SweepSettings, trial_seed
 
 

@@ -17,9 +17,9 @@ import optuna
 from optuna.trial import TrialState
 
 from roto.envs.roto_env import RotoEnv
-from roto.sweep.claims import run_claimed, tell_failed
+from roto.jobs.claims import run_claimed, tell_failed
+from roto.jobs.storage import fail_stale_trials, reclaim_now, wait_for_running
 from roto.sweep.space import load_space
-from roto.sweep.storage import fail_stale_trials, reclaim_now, wait_for_running
 from roto.sweep.study import SweepSettings, open_study
 from roto.sweep.trial import run_trial
 

@@ -8,10 +8,10 @@ import optuna
 import yaml
 from optuna.trial import TrialState
 
+from roto.jobs.storage import REASON_ATTR, open_storage
 from roto.olympiad.plan import load_plan
 from roto.olympiad.worker import CELL_ATTR, cell_status, study_name
 from roto.rl.evaluation import read_evaluations
-from roto.sweep.storage import REASON_ATTR, open_storage
 from tests.olympiad.toy_plan import toy_worker, write_toy_plan
 
 

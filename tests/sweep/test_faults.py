@@ -11,10 +11,10 @@ import torch
 from optuna.exceptions import StorageInternalError
 from optuna.trial import TrialState
 
+from roto.jobs.journal import TAIL_CHUNK, drop_torn_tail
+from roto.jobs.retrying_storage import DatabaseUnreachable, RetryingStorage
+from roto.jobs.storage import HEARTBEAT_ATTR, JOURNAL_NAME, REASON_ATTR, open_storage
 from roto.rl.evaluation import read_evaluations
-from roto.sweep.journal import TAIL_CHUNK, drop_torn_tail
-from roto.sweep.retrying_storage import DatabaseUnreachable, RetryingStorage
-from roto.sweep.storage import HEARTBEAT_ATTR, JOURNAL_NAME, REASON_ATTR, open_storage
 from roto.sweep.study import open_study
 from roto.sweep.trial import run_dir_of
 from roto.sweep.worker import run_worker
@@ -174,7 +174,7 @@ def test_a_database_gone_for_good_is_a_one_line_runtime_failure_of_the_cli():
 
 
 def test_a_live_trial_declared_dead_is_left_to_its_retry_which_continues_its_run(tmp_path, capsys):
-    from roto.sweep.storage import reclaim_now
+    from roto.jobs.storage import reclaim_now
 
     torch.set_num_threads(1)
     settings = toy_settings(tmp_path, trials=1, updates=8, heartbeat=30.0)

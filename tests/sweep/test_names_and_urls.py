@@ -2,8 +2,8 @@
 
 import pytest
 
+from roto.jobs.storage import redact_url
 from roto.sweep import study as study_module
-from roto.sweep.storage import redact_url
 from roto.sweep.study import check_study_name, load_existing_study
 
 
@@ -38,7 +38,7 @@ def test_a_missing_study_in_a_database_is_reported_without_the_password(monkeypa
 def test_plain_postgresql_urls_reach_the_server_through_the_installed_driver(postgres_url, tmp_path):
     import optuna
 
-    from roto.sweep.storage import open_storage
+    from roto.jobs.storage import open_storage
 
     plain = postgres_url.replace("postgresql+psycopg2://", "postgresql://")
     storage = open_storage(tmp_path, plain)  # the --help's example form
@@ -50,7 +50,7 @@ def test_a_server_that_never_answers_times_out_with_a_clear_error(monkeypatch, t
     import socket
     import time
 
-    from roto.sweep import storage
+    from roto.jobs import storage
 
     listener = socket.socket()
     listener.bind(("127.0.0.1", 0))
@@ -65,7 +65,7 @@ def test_a_server_that_never_answers_times_out_with_a_clear_error(monkeypatch, t
 
 
 def test_a_worker_killed_by_a_signal_fails_the_command_and_is_named(capsys):
-    from roto.sweep.claims import worst_exit
+    from roto.jobs.claims import worst_exit
 
     assert worst_exit([0, 0], [11, 12]) == 0 and capsys.readouterr().err == ""
     assert worst_exit([0, -9], [11, 12]) == 1
@@ -111,7 +111,7 @@ def test_a_sigterm_to_the_launcher_is_passed_on_to_each_running_worker():
     import sys
     import threading
 
-    from roto.sweep.claims import wait_passing_on_sigterm
+    from roto.jobs.claims import wait_passing_on_sigterm
 
     sleep = [sys.executable, "-c", "import time; time.sleep(60)"]
     done = subprocess.Popen([sys.executable, "-c", "pass"])

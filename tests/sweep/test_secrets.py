@@ -11,7 +11,7 @@ import pytest
 from optuna.exceptions import StorageInternalError
 
 from roto.cli import main
-from roto.sweep.storage import STORAGE_ENV, redact_url, resolve_storage, scrub
+from roto.jobs.storage import STORAGE_ENV, redact_url, resolve_storage, scrub
 
 needs_psycopg2 = pytest.mark.skipif(
     importlib.util.find_spec("psycopg2") is None, reason="connects through psycopg2 (the postgres extra)"
@@ -216,7 +216,7 @@ class _Refusing:
 @needs_psycopg2
 def test_a_refused_table_privilege_is_named_at_once_not_retried():
     from roto.cli_errors import error_exit
-    from roto.sweep.retrying_storage import DatabasePermissionDenied, RetryingStorage, permission_error
+    from roto.jobs.retrying_storage import DatabasePermissionDenied, RetryingStorage, permission_error
 
     assert permission_error(_insufficient_privilege()) is not None
     assert permission_error(StorageInternalError("exceeding max length")) is None
@@ -235,8 +235,8 @@ def test_a_role_without_privileges_is_told_what_it_lacks(postgres_url, tmp_path,
     import optuna
     import sqlalchemy
 
-    from roto.sweep.retrying_storage import DatabasePermissionDenied
-    from roto.sweep.storage import open_storage
+    from roto.jobs.retrying_storage import DatabasePermissionDenied
+    from roto.jobs.storage import open_storage
 
     open_storage(tmp_path, postgres_url)  # Optuna's tables, made by their owner
     engine = sqlalchemy.create_engine(postgres_url, isolation_level="AUTOCOMMIT")

@@ -10,11 +10,11 @@ import torch
 import yaml
 from optuna.trial import TrialState
 
+from roto.jobs.storage import REASON_ATTR, open_storage
 from roto.rl.config import load_agent_config
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import CHECKPOINT_DIR
 from roto.sweep.report import export_best, show
-from roto.sweep.storage import REASON_ATTR, open_storage
 from roto.sweep.study import SEEDS, open_study
 from roto.sweep.trial import run_dir_of
 from roto.sweep.worker import run_worker

@@ -19,9 +19,9 @@ import optuna
 from optuna.exceptions import UpdateFinishedTrialError
 from optuna.trial import TrialState
 
+from roto.jobs.optuna_ids import storage_id
+from roto.jobs.storage import REASON_ATTR, Heartbeat, enqueue_retry
 from roto.rl.stop_requests import signal_handlers
-from roto.sweep.optuna_ids import storage_id
-from roto.sweep.storage import REASON_ATTR, Heartbeat, enqueue_retry
 
 
 def run_claimed(

@@ -37,9 +37,9 @@ from optuna.storages import RetryHeartbeatStaleTrialCallback
 from optuna.storages.journal import JournalStorage
 from optuna.trial import TrialState
 
-from roto.sweep.journal import JournalFile
-from roto.sweep.optuna_ids import storage_id
-from roto.sweep.retrying_storage import RetryingStorage, first_line, permission_denied, permission_error
+from roto.jobs.journal import JournalFile
+from roto.jobs.optuna_ids import storage_id
+from roto.jobs.retrying_storage import RetryingStorage, first_line, permission_denied, permission_error
 
 JOURNAL_NAME = "journal.log"
 HEARTBEAT_ATTR = "roto:heartbeat"
