@@ -8,6 +8,7 @@ import pytest
 import yaml
 
 from roto.cli import main
+from roto.rl.checkpoints import load_checkpoint
 from roto.rl.run_dir import load_policy
 from roto.rl.runner import Trainer
 
@@ -51,6 +52,7 @@ def trained_run(tmp_path_factory):
 def test_train_writes_config_checkpoints_csv_and_events(trained_run, capsys):
     config = yaml.safe_load((trained_run / "config.yaml").read_text())
     assert config["train"]["env"]["action_smoothing"] == 0.9 and config["agent"]["ppo"]["rollouts"] == 4
+    assert config["format"] == 1 and load_checkpoint(trained_run / "checkpoints" / "latest.pt")["format"] == 1
     ckpts = trained_run / "checkpoints"
     assert (ckpts / "latest.pt").is_file() and (ckpts / "agent_3.pt").is_file()
     csv_text = (trained_run / "scalars.csv").read_text()

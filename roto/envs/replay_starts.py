@@ -19,6 +19,7 @@ import mujoco
 import numpy as np
 import torch
 
+from roto.artifact_formats import FORMAT_KEY, check_format
 from roto.envs.config import EnvConfig
 from roto.sim.mujoco_cpu import state_offsets
 
@@ -106,6 +107,8 @@ def check_bank(path: str, arrays: dict[str, np.ndarray], task: str, robot: str, 
         ValueError naming the file, what was expected and what was found.
     """
     where = f"replay_starts {path!r}"
+    found = arrays.get(FORMAT_KEY)
+    check_format("bank", None if found is None else found.item(), where)
     for name, own in (("task", task), ("robot", robot)):  # a bank without the entry: its shapes must fit
         if name in arrays and str(arrays[name]) != own:
             raise ValueError(f"{where}: states recorded on {name} {str(arrays[name])!r}, not this env's {own!r}")

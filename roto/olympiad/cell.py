@@ -20,6 +20,7 @@ from collections.abc import Callable
 from typing import Any
 
 import roto
+from roto.artifact_formats import format_stamp
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
 from roto.eval.evaluate import evaluate
@@ -104,6 +105,7 @@ def run_cell(
     records = read_evaluations(run_dir)
     entry = plan.variants[cell.variant].for_task(cell.task)
     summary = {
+        **format_stamp("cell summary"),
         **{key: getattr(cell, key) for key in ("task", "robot", "obs", "variant", "seed")},
         "task_version": get_task(cell.task).version,
         "plan": plan.name,

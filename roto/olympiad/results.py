@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from roto.artifact_formats import FORMAT_KEY, check_format
 from roto.cli_errors import check_output_path
 from roto.eval.plots import plot_variants
 from roto.olympiad.plan import load_plan
@@ -103,6 +104,7 @@ def check_summary(path: str | pathlib.Path, summary: Any) -> dict:
     where = f"cell summary {str(path)!r}"
     if not isinstance(summary, dict):
         raise ValueError(f"{where} holds {json_kind(summary)}, not an object (a cell summary of roto olympiad)")
+    check_format("cell summary", summary.get(FORMAT_KEY), where)
     missing = [key for key in SUMMARY_FIELDS if key not in summary]
     if missing:
         raise ValueError(f"{where} lacks the field(s) {missing}; a cell summary has {list(SUMMARY_FIELDS)}")

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
+from roto.artifact_formats import FORMATS
 from roto.envs.ball_paths import BALL_GROUP, BallPathRecorder
 from roto.envs.control import target_to_action
 from roto.envs.roto_env import RotoEnv
@@ -157,6 +158,7 @@ def save_preswap_states(path, robot: str, states: PreswapStates) -> None:
         path,
         robot=np.array(robot),
         task=np.array("baoding"),
+        format=np.array(FORMATS["bank"]),
         lead_steps=np.array(states.lead, dtype=np.int64),
         physics=np.array(states.physics).reshape(len(states.physics), -1),
         target=np.array(states.target).reshape(len(states.target), -1),

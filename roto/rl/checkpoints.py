@@ -12,6 +12,8 @@ from typing import Any
 
 import torch
 
+from roto.artifact_formats import FORMAT_KEY, check_format
+
 
 def save_checkpoint(state: dict[str, Any], path: pathlib.Path) -> None:
     """Write ``state`` atomically (a temporary file, then a rename)."""
@@ -43,6 +45,7 @@ def load_checkpoint(path: str | pathlib.Path, device: torch.device | str = "cpu"
         raise ValueError(f"{where}: {_load_failure(error)}") from None
     if not isinstance(state, dict) or not {"model", "train", "agent"} <= state.keys():
         raise ValueError(f"{str(path)!r} is not a roto checkpoint: it lacks the model, train and agent entries")
+    check_format("checkpoint", state.get(FORMAT_KEY), f"checkpoint {str(path)!r}")
     return state
 
 

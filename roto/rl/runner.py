@@ -16,6 +16,7 @@ from typing import Any
 import torch
 from tqdm import tqdm
 
+from roto.artifact_formats import format_stamp
 from roto.envs.ball_paths import for_path_metrics
 from roto.envs.config import EnvConfig
 from roto.envs.episodes import readable
@@ -276,6 +277,7 @@ class Trainer:
         """The policy and what loading it needs (``POLICY_KEYS``): no optimiser, env or RNG state
         (a third of ``state_dict``'s size, and nothing copied from the envs)."""
         return {
+            **format_stamp("checkpoint"),
             "model": self.model.state_dict(),
             "train": self.settings.to_dict(),
             "agent": to_dict(self.agent),

@@ -9,6 +9,7 @@ from typing import Any
 
 import yaml
 
+from roto.artifact_formats import FORMAT_KEY, check_format, format_stamp
 from roto.envs.config import EnvConfig
 from roto.result_files import write_text_atomic
 from roto.rl.config import AgentConfig, from_dict, to_dict
@@ -57,7 +58,7 @@ class TrainSettings:
 
 def run_config(settings: TrainSettings, agent: AgentConfig) -> dict[str, Any]:
     """The resolved config of a run as a plain nested dict: {"train": settings, "agent": agent config}."""
-    return {"train": settings.to_dict(), "agent": to_dict(agent)}
+    return {**format_stamp("run config"), "train": settings.to_dict(), "agent": to_dict(agent)}
 
 
 def write_run_config(run_dir: pathlib.Path, settings: TrainSettings, agent: AgentConfig) -> None:
@@ -73,4 +74,5 @@ def read_run_config(run_dir: pathlib.Path) -> tuple[TrainSettings, AgentConfig]:
     data = read_yaml(path, "run config")
     if not isinstance(data, dict) or not {"train", "agent"} <= set(data):
         raise ValueError(f"run config {str(path)!r} is not a roto run config (no 'train' and 'agent' sections)")
+    check_format("run config", data.get(FORMAT_KEY), f"run config {str(path)!r}")
     return TrainSettings.from_dict(data["train"]), from_dict(AgentConfig, data["agent"]).validate()

@@ -1,0 +1,35 @@
+"""Format versions of the files roto writes and reads back: checkpoints, run configs, cell
+summaries and banks of recorded states each carry ``format``; a reader refuses a format it does
+not know in one line, instead of misreading a file a newer roto wrote. A file without the entry
+predates format versions and has format 1's layout.
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+
+FORMAT_KEY = "format"
+FORMATS = MappingProxyType({"checkpoint": 1, "run config": 1, "cell summary": 1, "bank": 1})
+"""{kind of file: the format this roto writes (and the newest it reads)}."""
+
+
+def format_stamp(kind: str) -> dict[str, int]:
+    """The entry a ``kind`` file carries: {"format": its format}."""
+    return {FORMAT_KEY: FORMATS[kind]}
+
+
+def check_format(kind: str, found: object, where: str) -> None:
+    """Refuse ``found``, the format entry of the ``kind`` file ``where`` names (None: no entry),
+    unless this roto reads it.
+
+    Raises:
+        ValueError naming the file, the format found and the formats this roto reads.
+    """
+    if found is None:
+        return
+    known = FORMATS[kind]
+    if isinstance(found, bool) or not isinstance(found, int) or not 1 <= found <= known:
+        raise ValueError(
+            f"{where} is a {kind} of format {found!r}; this roto reads {kind} formats 1 to {known} "
+            "(a newer roto wrote it? update roto)"
+        )
