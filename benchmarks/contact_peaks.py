@@ -8,7 +8,8 @@ state is re-evaluated with ``mj_forward`` to read its ``ncon`` and ``nefc``:
 * ``random``: a new uniform random action every step (the bench workload; the hand flails);
 * ``held``: zero action, the default pose holding the task's balls.
 
-Prints one JSON line per pair with the peaks; ``roto.sim.capacity`` takes them with margin.
+Prints one JSON line per pair with the peaks; each hand's record of the pair keeps them
+(``PairRecord.warp_peaks``) and ``roto.envs.capacity`` adds the margin.
 """
 
 from __future__ import annotations

@@ -25,6 +25,7 @@ from roto.eval.plots import plot_variants
 from roto.olympiad.plan import load_plan
 from roto.olympiad.stats import iqm, probability_of_improvement, stratified_bootstrap_ci
 from roto.result_files import read_json, replacing, write_text_atomic
+from roto.robots import ROBOTS
 from roto.tasks import get_task
 
 ROTO_V1_SHADOW = {
@@ -166,7 +167,7 @@ def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None, 
     agents = agents or {}
     columns = sorted({(task, obs, variant) for task, _, obs, variant in scores})
     tasks = sorted({task for task, _, _ in columns})
-    order = list(get_task("bounce").reference)
+    order = list(ROBOTS)  # the hand registry's order
     robots = sorted({robot for _, robot, _, _ in scores}, key=lambda r: order.index(r) if r in order else len(order))
 
     current = [t for t in tasks if t in (current or set())]  # tasks whose summaries are all of today's version

@@ -12,11 +12,12 @@ towards +x (the palm side), the index finger is on +y.
 from __future__ import annotations
 
 import math
+from types import MappingProxyType
 
 import mujoco
 import numpy as np
 
-from roto.robots.spec import Gains, RobotSpec, side_by_side
+from roto.robots.spec import Gains, PairRecord, RobotSpec, side_by_side
 
 _BAODING_RADIUS = 0.5 * 2.0 * 0.0254
 
@@ -197,4 +198,10 @@ ALLEGRO = RobotSpec(
     # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's Allegro variant, the
     # second target beside it, 2r + 5 mm away across the fingers (towards the index finger)
     baoding_targets=side_by_side((0.0589, 0.0, 0.0217), _BAODING_RADIUS, (0.0, -1.0, 0.0)),
+    tasks=MappingProxyType(
+        {
+            "bounce": PairRecord(reference=11.8, warp_peaks=(23, 92)),
+            "baoding": PairRecord(reference=5.03, warp_peaks=(24, 96)),
+        }
+    ),
 )

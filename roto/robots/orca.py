@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import importlib.util
 import pathlib
+from types import MappingProxyType
 
 import mujoco
 import numpy as np
 
-from roto.robots.spec import Gains, RobotSpec, diagonal_stack
+from roto.robots.spec import Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.5 * 0.0254
 
@@ -122,5 +123,11 @@ ORCA = RobotSpec(
     excluded_contacts=(
         *((_j("palm"), _j(f"{f}_{link}")) for f in (*_FINGERS, "thumb") for link in ("pp", "ip")),
         (_j("palm"), _j("thumb_mp")),
+    ),
+    tasks=MappingProxyType(
+        {
+            "bounce": PairRecord(reference=12.0, warp_peaks=(63, 270)),
+            "baoding": PairRecord(reference=5.78, warp_peaks=(65, 277)),
+        }
     ),
 )

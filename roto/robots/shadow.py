@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import importlib.util
 import pathlib
+from types import MappingProxyType
 
 import mujoco
 
-from roto.robots.spec import Gains, RobotSpec, diagonal_stack
+from roto.robots.spec import Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.5 * 0.0254
 
@@ -91,4 +92,10 @@ SHADOW = RobotSpec(
     baoding_ball_radius=_BAODING_RADIUS,
     # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack δ·(1, 1, 1) above it
     baoding_targets=diagonal_stack((0.0577, -0.0079, -0.0066), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
+    tasks=MappingProxyType(
+        {
+            "bounce": PairRecord(reference=27.9, warp_peaks=(10, 62)),
+            "baoding": PairRecord(reference=7.31, warp_peaks=(12, 65)),
+        }
+    ),
 )

@@ -10,12 +10,13 @@ Joint names keep the gym convention (J0 distal, J3 abduction).
 from __future__ import annotations
 
 import math
+from types import MappingProxyType
 
 import mujoco
 import numpy as np
 
 from roto.robots.shadow import load_shadow_spec
-from roto.robots.spec import Gains, RobotSpec, diagonal_stack
+from roto.robots.spec import Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.2 * 0.0254
 
@@ -131,4 +132,10 @@ SHADOW_LITE = RobotSpec(
     # above the finger pocket: dropped above the palm centre, 12 of 12 pairs fell off (docs/tasks.md)
     baoding_drop_centre=(0.041, -0.014, 0.09),
     excluded_contacts=tuple((_j("palm"), _j(b)) for b in ("ffknuckle", "mfknuckle", "rfknuckle", "thbase")),
+    tasks=MappingProxyType(
+        {
+            "bounce": PairRecord(reference=9.5, warp_peaks=(8, 53)),
+            "baoding": PairRecord(reference=5.5, warp_peaks=(9, 48)),
+        }
+    ),
 )

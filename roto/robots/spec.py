@@ -22,6 +22,22 @@ class Gains:
 
 
 @dataclass(frozen=True, kw_only=True)
+class PairRecord:
+    """What belongs to one (task, hand) pair, measured on that hand (docs/robots.md).
+
+    Attributes:
+        reference: the task's reference (``Task.reference_name``: scripted Bounce, the Baoding
+            reference controller) on this hand, in the task's headline metric per 10 s.
+        warp_peaks: the most contacts and constraint rows any world needed
+            (``benchmarks/contact_peaks.py``); the Warp backend sizes its buffers from them
+            (``roto.envs.capacity``).
+    """
+
+    reference: float
+    warp_peaks: tuple[int, int]
+
+
+@dataclass(frozen=True, kw_only=True)
 class RobotSpec:
     """One hand, described as data.
 
@@ -38,6 +54,8 @@ class RobotSpec:
         palm_geom: the collision geom whose top face is the palm surface.
         knuckle_bodies: finger base bodies, index finger first and little (or last) finger last.
         tip_bodies: distal finger bodies, used to find the finger direction.
+        tasks: task name -> the pair's record (``PairRecord``): what was measured of this hand on
+            that task.
         thumb_tip: the thumb's distal body (with ``tip_bodies`` and the palm: where taxels lie).
         baoding_ball_radius: Baoding ball radius for this hand (m).
         baoding_targets: T_a and T_b (task frame, m): roto's diagonal stack (``diagonal_stack``) or
@@ -72,6 +90,7 @@ class RobotSpec:
     coupled_joints: Mapping[str, tuple[str, float]] = field(default_factory=dict)
     excluded_contacts: tuple[tuple[str, str], ...] = field(default=())
     palm_tilt: tuple[float, float] = (0.0, 0.0)
+    tasks: Mapping[str, PairRecord] = field(default_factory=dict)
 
     def gains_for(self, joint: str) -> Gains:
         """The gains of one actuated joint: the first key of ``gains`` contained in its name."""

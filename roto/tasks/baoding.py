@@ -10,6 +10,7 @@ import mujoco
 import numpy as np
 import torch
 
+from roto.robots import pair_references
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
 from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where, zero_on_host
@@ -159,9 +160,13 @@ class Baoding:
     ``roto.envs.aids.tolerance``) and the turns a paid swap must follow (0: every swap is paid; the
     round-swaps aid sets it, ``roto.tasks.round_swaps``)."""
     reference_name = "reference controller"
-    reference = MappingProxyType({"shadow": 7.31, "shadow_lite": 5.50, "allegro": 5.03, "orca": 5.78})
-    """Rotations per 10 s of the predictive-sampling reference controller, 16 episodes each,
-    ``roto demo --task baoding`` (docs/robots.md)."""
+
+    @property
+    def reference(self) -> Mapping[str, float]:
+        """{robot: rotations per 10 s of the predictive-sampling reference controller, 16 episodes}
+        (``roto demo --task baoding``), from each hand's record."""
+        return pair_references(self.name)
+
     observation_size = 8
     path_metric_names = ("net_turns", "travelled_turns", "round_rotations")
     """Whether the balls went round each other or swung out and back (``roto.tasks.pair_turns``): a

@@ -8,6 +8,7 @@ from types import MappingProxyType
 
 import torch
 
+from roto.robots import pair_references
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec
 from roto.tasks.arrays import as_dtype_of, squared_norm, where
@@ -77,8 +78,12 @@ class Bounce:
     metric_names = ("bounces",)
     headline_metric = "bounces"
     reference_name = "scripted Bounce"
-    reference = MappingProxyType({"shadow": 27.9, "shadow_lite": 9.5, "allegro": 11.8, "orca": 12.0})
-    """Bounces per 10 s of each hand's scripted policy, ``roto demo`` (docs/robots.md)."""
+
+    @property
+    def reference(self) -> Mapping[str, float]:
+        """{robot: bounces per 10 s of its scripted policy} (``roto demo``), from each hand's record."""
+        return pair_references(self.name)
+
     observation_size = 3
     path_metric_names = ()
     parameters = MappingProxyType({})
