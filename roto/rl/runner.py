@@ -223,10 +223,8 @@ class Trainer:
             t_inference += t1 - t0
             t_sim += t2 - t1
         scalars = {"perf/inference_s": t_inference, "perf/simulation_s": t_sim}
-        aid_metrics = self.env.aid_metrics()
-        if aid_metrics:  # the training aids' state, read once per update
-            with deliberate_host_sync(self.device):
-                scalars.update({name: float(value) for name, value in aid_metrics.items()})
+        with deliberate_host_sync(self.device):  # the training aids' state (if any), read once per update
+            scalars.update({name: float(value) for name, value in self.env.aid_metrics().items()})
         return scalars
 
     def _evaluate(self) -> dict[str, float]:
