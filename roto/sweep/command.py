@@ -6,11 +6,16 @@ import argparse
 import json
 import sys
 
+from roto.sweep.settings import sweep_defaults
+
 STORAGE_HELP = (
     "database URL (postgresql://...) or a journal file's path (*.log); default: <root>/<study>/journal.log. "
     "env:NAME reads it from environment variable NAME (as the workers --workers starts do, so that no "
     "password shows in their command lines)"
 )
+
+DEFAULTS = sweep_defaults()
+"""The flags' defaults: ``SweepSettings``' own, written once."""
 
 RUN_FLAGS = ("task", "robot", "obs", "agent_cfg", "space", "objective", "trials", "startup", "steps", "warmup_steps",
              "num_envs", "threads", "root", "storage", "heartbeat")  # fmt: skip
@@ -19,33 +24,43 @@ RUN_FLAGS = ("task", "robot", "obs", "agent_cfg", "space", "objective", "trials"
 
 def _study_args(parser: argparse.ArgumentParser, required: bool) -> None:
     parser.add_argument("--study", required=required, help="study name (its folder: <root>/<study>)")
-    parser.add_argument("--root", default="runs/sweeps", help="folder of the studies' folders (default runs/sweeps)")
-    parser.add_argument("--storage", default=None, help=STORAGE_HELP)
+    parser.add_argument("--root", default=DEFAULTS["root"], help="folder of the studies' folders (default %(default)s)")
+    parser.add_argument("--storage", default=DEFAULTS["storage"], help=STORAGE_HELP)
 
 
 def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     """Register ``roto sweep`` and its ``export`` and ``show`` subcommands."""
     p = sub.add_parser("sweep", help="tune an agent with Optuna (TPE, median pruning), on one or many machines")
-    p.add_argument("--task", default="bounce")
-    p.add_argument("--robot", default="shadow")
-    p.add_argument("--obs", default="blind", help="blind, state or proprio")
-    p.add_argument("--agent_cfg", "--agent-cfg", dest="agent_cfg", default=None, help="base agent config")
+    p.add_argument("--task", default=DEFAULTS["task"])
+    p.add_argument("--robot", default=DEFAULTS["robot"])
+    p.add_argument("--obs", default=DEFAULTS["obs"], help="blind, state or proprio")
     p.add_argument(
-        "--space", default="roto2", help="search space: a name in roto/configs/sweep/ (default roto2) or a YAML file"
+        "--agent_cfg", "--agent-cfg", dest="agent_cfg", default=DEFAULTS["agent_cfg"], help="base agent config"
     )
-    p.add_argument("--objective", default="return",
+    p.add_argument(
+        "--space",
+        default=DEFAULTS["space"],
+        help="search space: a name in roto/configs/sweep/ (default %(default)s) or a YAML file",
+    )
+    p.add_argument("--objective", default=DEFAULTS["objective"],
                    help="what trials maximise: the best evaluation's mean return (default), 'metric' (the task's "
                         "headline metric, Baoding: rotations), or another metric the task's evaluations report "
                         "(Baoding: round_rotations, the rotations its pair's net turning backs), with the return "
                         "breaking ties")  # fmt: skip
-    p.add_argument("--trials", type=int, default=40, help="trials that finish (complete or pruned)")
-    p.add_argument("--startup", type=int, default=8, help="random start-up trials (also the pruner's wait)")
-    p.add_argument("--steps", type=int, default=2_500_000, help="env steps per trial")
-    p.add_argument("--warmup_steps", type=int, default=None, help="env steps before pruning (default steps/5)")
-    p.add_argument("--num_envs", type=int, default=128)
-    p.add_argument("--threads", type=int, default=1, help="C threads stepping each worker's envs")
+    p.add_argument("--trials", type=int, default=DEFAULTS["trials"], help="trials that finish (complete or pruned)")
+    p.add_argument(
+        "--startup", type=int, default=DEFAULTS["startup"], help="random start-up trials (also the pruner's wait)"
+    )
+    p.add_argument("--steps", type=int, default=DEFAULTS["steps"], help="env steps per trial")
+    p.add_argument(
+        "--warmup_steps", type=int, default=DEFAULTS["warmup_steps"], help="env steps before pruning (default steps/5)"
+    )
+    p.add_argument("--num_envs", type=int, default=DEFAULTS["num_envs"])
+    p.add_argument("--threads", type=int, default=DEFAULTS["threads"], help="C threads stepping each worker's envs")
     p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
-    p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running trial's heartbeats")
+    p.add_argument(
+        "--heartbeat", type=float, default=DEFAULTS["heartbeat"], help="seconds between a running trial's heartbeats"
+    )
     p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
     p.add_argument("--enqueue_base", "--enqueue-base", dest="enqueue_base", action="store_true",
                    help="a new study's first trial: the base config's values of the searched parameters")  # fmt: skip
@@ -72,8 +87,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     from roto.jobs.claims import launch_workers
     from roto.jobs.storage import reclaim_now, resolve_storage, storage_in_environment
+    from roto.sweep.settings import SweepSettings
     from roto.sweep.space import load_space
-    from roto.sweep.study import SweepSettings, enqueue_base, open_study
+    from roto.sweep.study import enqueue_base, open_study
     from roto.sweep.worker import run_worker
 
     args.storage = resolve_storage(args.storage)

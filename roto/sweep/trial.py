@@ -26,8 +26,9 @@ from roto.rl.evaluation import read_evaluations
 from roto.rl.run_lock import wait_until_free
 from roto.rl.run_spec import RunSpec, build_run_spec
 from roto.rl.runner import Trainer
+from roto.sweep.settings import SweepSettings
 from roto.sweep.space import SearchSpace, as_overrides
-from roto.sweep.study import TIE_BREAK, SweepSettings, trial_seed
+from roto.sweep.study import TIE_BREAK, trial_seed
 
 
 def objective_value(record: dict[str, float], objective: str, headline_metric: str) -> float:

@@ -19,8 +19,9 @@ from optuna.trial import TrialState
 from roto.envs.roto_env import RotoEnv
 from roto.jobs.claims import run_claimed, tell_failed
 from roto.jobs.storage import fail_stale_trials, reclaim_now, wait_for_running
+from roto.sweep.settings import SweepSettings
 from roto.sweep.space import load_space
-from roto.sweep.study import SweepSettings, open_study
+from roto.sweep.study import open_study
 from roto.sweep.trial import run_trial
 
 ACTIVE = (TrialState.COMPLETE, TrialState.PRUNED, TrialState.RUNNING)

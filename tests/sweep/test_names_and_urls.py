@@ -4,7 +4,8 @@ import pytest
 
 from roto.jobs.storage import redact_url
 from roto.sweep import study as study_module
-from roto.sweep.study import check_study_name, load_existing_study
+from roto.sweep.settings import check_study_name
+from roto.sweep.study import load_existing_study
 
 
 @pytest.mark.parametrize("name", ["..", ".", "a/b", "../outside", "", "two words", "x\\y"])

@@ -172,7 +172,7 @@ def test_a_metric_objective_ranks_trials_by_the_headline_metric_with_the_return_
 
 def test_an_objective_may_name_another_metric_of_the_task_with_the_return_breaking_ties():
     from roto.sweep.report import _objective_name
-    from roto.sweep.study import SweepSettings, objectives_of
+    from roto.sweep.settings import SweepSettings, objectives_of
     from roto.sweep.trial import objective_value
 
     assert objectives_of("baoding")[-1] == "round_rotations"
@@ -218,8 +218,9 @@ def test_the_base_config_is_enqueued_as_the_first_trial_where_the_space_can_draw
 
 
 def test_the_enqueued_base_has_the_training_aids_of_its_agent_config(tmp_path):
+    from roto.sweep.settings import SweepSettings
     from roto.sweep.space import load_space
-    from roto.sweep.study import SweepSettings, enqueue_base
+    from roto.sweep.study import enqueue_base
 
     settings = SweepSettings(study="aids", task="baoding", agent_cfg="baoding_cpu_shadow", space="baoding_cpu",
                              objective="metric", trials=2, num_envs=8, root=str(tmp_path))  # fmt: skip

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pathlib
 
-from roto.sweep.study import SweepSettings
+from roto.sweep.settings import SweepSettings
 from roto.sweep.worker import run_worker
 from tests.rl.toy_env import ToyEnv
 
