@@ -18,112 +18,20 @@ on 16 envs and checked on 8 fresh seeds (docs/robots.md).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import torch
 
 from roto.envs.control import target_to_action
 from roto.envs.episodes import first_episodes
 from roto.envs.roto_env import RotoEnv
 from roto.registry import make
+from roto.robots import ROBOTS
+from roto.robots.spec import BounceScript
 
 HOLD, WIND_UP, STRIKE = 0, 1, 2
 
 
-@dataclass(frozen=True, kw_only=True)
-class BounceScript:
-    """Parameters of the scripted Bounce policy for one robot (angles in rad, lengths in m)."""
-
-    swing: dict[str, tuple[float, float, float]]
-    """Swing joint -> (hold, wind-up, strike) target angles."""
-    lean: dict[str, tuple[float, float]] = field(default_factory=dict)
-    """Swing joint -> change of its (wind-up, strike) angle per metre of ball x offset from ``centre_x``."""
-    pose: dict[str, float] = field(default_factory=dict)
-    """Targets of other joints during the whole episode; the rest keep the default pose."""
-    centre_x: float
-    wind_up_steps: int
-    strike_steps: int
-    settle_speed: float
-    """The ball counts as caught when it touches the hand with |vz| below this (m/s) for two steps."""
-
-
-SHADOW_BOUNCE = BounceScript(
-    swing={"robot0:WRJ0": (0.029, -0.663, 0.337)},
-    lean={"robot0:WRJ0": (2.86, 5.66)},
-    pose={
-        "robot0:FFJ2": 0.439,
-        "robot0:MFJ2": 0.439,
-        "robot0:RFJ2": 0.439,
-        "robot0:LFJ2": 0.439,
-        "robot0:FFJ3": -0.192,
-        "robot0:MFJ3": -0.085,
-        "robot0:RFJ3": -0.26,
-        "robot0:LFJ3": -0.226,
-        "robot0:THJ4": 1.102,
-        "robot0:THJ3": 0.268,
-    },
-    centre_x=0.0078,
-    wind_up_steps=4,
-    strike_steps=6,
-    settle_speed=0.25,
-)
-
-# The Lite has no wrist: its fingers extend (wind-up: the ball rolls out onto them, the hand being
-# tilted towards the fingertips), then flick up at the knuckles (J2) and middle joints (J1) while
-# the thumb (THJ3) swings up beside them.
-SHADOW_LITE_BOUNCE = BounceScript(
-    swing={
-        **{f"robot0:{f}J2": (0.223, 0.033, 1.504) for f in ("FF", "MF", "RF")},
-        **{f"robot0:{f}J1": (0.288, 0.0, 0.8) for f in ("FF", "MF", "RF")},
-        "robot0:THJ3": (0.197, 0.298, 0.986),
-    },
-    lean={f"robot0:{f}J2": (1.204, -3.184) for f in ("FF", "MF", "RF")},
-    pose={"robot0:THJ4": 0.665, "robot0:RFJ3": -0.31},
-    centre_x=0.03,
-    wind_up_steps=10,
-    strike_steps=4,
-    settle_speed=0.088,
-)
-
-# ORCA's wrist is strong (kp 100): it winds the fingers down (positive wrist) and strikes back up.
-ORCA_BOUNCE = BounceScript(
-    swing={"right_wrist": (-0.338, 0.661, 0.227)},
-    lean={"right_wrist": (3.112, -2.796)},
-    pose={
-        **{f"right_{f}_mcp": 0.368 for f in ("index", "middle", "ring", "pinky")},
-        **{f"right_{f}_pip": 0.542 for f in ("index", "middle", "ring", "pinky")},
-        "right_thumb_abd": -0.397,
-        "right_thumb_mcp": -0.87,
-    },
-    centre_x=-0.012,
-    wind_up_steps=6,
-    strike_steps=4,
-    settle_speed=0.075,
-)
-
-# The Allegro has no wrist either: its fingers curl the ball up from the palm (j2 straightens from
-# 1.23 to 0.32 while j1 rises and j3 flicks up) and the thumb swings up beside it (thj2).
-ALLEGRO_BOUNCE = BounceScript(
-    swing={
-        **{f"{f}j1": (0.211, 0.173, 0.472) for f in ("ff", "mf", "rf")},
-        **{f"{f}j2": (1.6, 1.231, 0.324) for f in ("ff", "mf", "rf")},
-        **{f"{f}j3": (0.681, -0.052, 1.04) for f in ("ff", "mf", "rf")},
-        "thj2": (0.674, 0.397, 1.64),
-    },
-    lean={f"{f}j1": (-6.244, -8.267) for f in ("ff", "mf", "rf")},
-    pose={"thj0": 0.325, "thj1": 0.079},
-    centre_x=-0.007,
-    wind_up_steps=2,
-    strike_steps=9,
-    settle_speed=0.346,
-)
-
-SCRIPTS: dict[str, BounceScript] = {
-    "shadow": SHADOW_BOUNCE,
-    "shadow_lite": SHADOW_LITE_BOUNCE,
-    "allegro": ALLEGRO_BOUNCE,
-    "orca": ORCA_BOUNCE,
-}
+SCRIPTS: dict[str, BounceScript] = {name: robot.tasks["bounce"].script for name, robot in ROBOTS.items()}
+"""Each hand's scripted Bounce motion, from its record of the pair (``roto/robots/<hand>.py``)."""
 
 
 class ScriptedBounce:

@@ -17,7 +17,7 @@ from types import MappingProxyType
 import mujoco
 import numpy as np
 
-from roto.robots.spec import Gains, PairRecord, RobotSpec, side_by_side
+from roto.robots.spec import BounceScript, Gains, PairRecord, RobotSpec, side_by_side
 
 _BAODING_RADIUS = 0.5 * 2.0 * 0.0254
 
@@ -162,6 +162,24 @@ def load_allegro_spec() -> mujoco.MjSpec:
 
 _ACTUATED = tuple(f"{f}j{i}" for f in ("ff", "mf", "rf", "th") for i in range(4))
 
+# The Allegro has no wrist either: its fingers curl the ball up from the palm (j2 straightens from
+# 1.23 to 0.32 while j1 rises and j3 flicks up) and the thumb swings up beside it (thj2).
+ALLEGRO_BOUNCE = BounceScript(
+    swing={
+        **{f"{f}j1": (0.211, 0.173, 0.472) for f in ("ff", "mf", "rf")},
+        **{f"{f}j2": (1.6, 1.231, 0.324) for f in ("ff", "mf", "rf")},
+        **{f"{f}j3": (0.681, -0.052, 1.04) for f in ("ff", "mf", "rf")},
+        "thj2": (0.674, 0.397, 1.64),
+    },
+    lean={f"{f}j1": (-6.244, -8.267) for f in ("ff", "mf", "rf")},
+    pose={"thj0": 0.325, "thj1": 0.079},
+    centre_x=-0.007,
+    wind_up_steps=2,
+    strike_steps=9,
+    settle_speed=0.346,
+)
+
+
 ALLEGRO = RobotSpec(
     name="allegro",
     display_name="Allegro",
@@ -200,7 +218,7 @@ ALLEGRO = RobotSpec(
     baoding_targets=side_by_side((0.0589, 0.0, 0.0217), _BAODING_RADIUS, (0.0, -1.0, 0.0)),
     tasks=MappingProxyType(
         {
-            "bounce": PairRecord(reference=11.8, warp_peaks=(23, 92)),
+            "bounce": PairRecord(reference=11.8, warp_peaks=(23, 92), script=ALLEGRO_BOUNCE),
             "baoding": PairRecord(reference=5.03, warp_peaks=(24, 96)),
         }
     ),

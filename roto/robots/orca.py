@@ -15,7 +15,7 @@ from types import MappingProxyType
 import mujoco
 import numpy as np
 
-from roto.robots.spec import Gains, PairRecord, RobotSpec, diagonal_stack
+from roto.robots.spec import BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.5 * 0.0254
 
@@ -78,6 +78,23 @@ _ACTUATED = tuple(
     )
 )  # fmt: skip
 
+# ORCA's wrist is strong (kp 100): it winds the fingers down (positive wrist) and strikes back up.
+ORCA_BOUNCE = BounceScript(
+    swing={"right_wrist": (-0.338, 0.661, 0.227)},
+    lean={"right_wrist": (3.112, -2.796)},
+    pose={
+        **{f"right_{f}_mcp": 0.368 for f in ("index", "middle", "ring", "pinky")},
+        **{f"right_{f}_pip": 0.542 for f in ("index", "middle", "ring", "pinky")},
+        "right_thumb_abd": -0.397,
+        "right_thumb_mcp": -0.87,
+    },
+    centre_x=-0.012,
+    wind_up_steps=6,
+    strike_steps=4,
+    settle_speed=0.075,
+)
+
+
 ORCA = RobotSpec(
     name="orca",
     display_name="ORCA",
@@ -126,7 +143,7 @@ ORCA = RobotSpec(
     ),
     tasks=MappingProxyType(
         {
-            "bounce": PairRecord(reference=12.0, warp_peaks=(63, 270)),
+            "bounce": PairRecord(reference=12.0, warp_peaks=(63, 270), script=ORCA_BOUNCE),
             "baoding": PairRecord(reference=5.78, warp_peaks=(65, 277)),
         }
     ),

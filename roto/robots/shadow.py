@@ -13,7 +13,7 @@ from types import MappingProxyType
 
 import mujoco
 
-from roto.robots.spec import Gains, PairRecord, RobotSpec, diagonal_stack
+from roto.robots.spec import BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.5 * 0.0254
 
@@ -59,6 +59,28 @@ _ACTUATED = tuple(
     )
 )  # fmt: skip
 
+SHADOW_BOUNCE = BounceScript(
+    swing={"robot0:WRJ0": (0.029, -0.663, 0.337)},
+    lean={"robot0:WRJ0": (2.86, 5.66)},
+    pose={
+        "robot0:FFJ2": 0.439,
+        "robot0:MFJ2": 0.439,
+        "robot0:RFJ2": 0.439,
+        "robot0:LFJ2": 0.439,
+        "robot0:FFJ3": -0.192,
+        "robot0:MFJ3": -0.085,
+        "robot0:RFJ3": -0.26,
+        "robot0:LFJ3": -0.226,
+        "robot0:THJ4": 1.102,
+        "robot0:THJ3": 0.268,
+    },
+    centre_x=0.0078,
+    wind_up_steps=4,
+    strike_steps=6,
+    settle_speed=0.25,
+)
+
+
 SHADOW = RobotSpec(
     name="shadow",
     display_name="Shadow",
@@ -94,7 +116,7 @@ SHADOW = RobotSpec(
     baoding_targets=diagonal_stack((0.0577, -0.0079, -0.0066), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
     tasks=MappingProxyType(
         {
-            "bounce": PairRecord(reference=27.9, warp_peaks=(10, 62)),
+            "bounce": PairRecord(reference=27.9, warp_peaks=(10, 62), script=SHADOW_BOUNCE),
             "baoding": PairRecord(reference=7.31, warp_peaks=(12, 65)),
         }
     ),

@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 
 from roto.robots.shadow import load_shadow_spec
-from roto.robots.spec import Gains, PairRecord, RobotSpec, diagonal_stack
+from roto.robots.spec import BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.2 * 0.0254
 
@@ -94,6 +94,24 @@ _OBSERVED = tuple(
     )
 )  # fmt: skip
 
+# The Lite has no wrist: its fingers extend (wind-up: the ball rolls out onto them, the hand being
+# tilted towards the fingertips), then flick up at the knuckles (J2) and middle joints (J1) while
+# the thumb (THJ3) swings up beside them.
+SHADOW_LITE_BOUNCE = BounceScript(
+    swing={
+        **{f"robot0:{f}J2": (0.223, 0.033, 1.504) for f in ("FF", "MF", "RF")},
+        **{f"robot0:{f}J1": (0.288, 0.0, 0.8) for f in ("FF", "MF", "RF")},
+        "robot0:THJ3": (0.197, 0.298, 0.986),
+    },
+    lean={f"robot0:{f}J2": (1.204, -3.184) for f in ("FF", "MF", "RF")},
+    pose={"robot0:THJ4": 0.665, "robot0:RFJ3": -0.31},
+    centre_x=0.03,
+    wind_up_steps=10,
+    strike_steps=4,
+    settle_speed=0.088,
+)
+
+
 SHADOW_LITE = RobotSpec(
     name="shadow_lite",
     display_name="ShadowLite",
@@ -134,7 +152,7 @@ SHADOW_LITE = RobotSpec(
     excluded_contacts=tuple((_j("palm"), _j(b)) for b in ("ffknuckle", "mfknuckle", "rfknuckle", "thbase")),
     tasks=MappingProxyType(
         {
-            "bounce": PairRecord(reference=9.5, warp_peaks=(8, 53)),
+            "bounce": PairRecord(reference=9.5, warp_peaks=(8, 53), script=SHADOW_LITE_BOUNCE),
             "baoding": PairRecord(reference=5.5, warp_peaks=(9, 48)),
         }
     ),

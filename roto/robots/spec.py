@@ -22,6 +22,24 @@ class Gains:
 
 
 @dataclass(frozen=True, kw_only=True)
+class BounceScript:
+    """Parameters of the scripted Bounce policy (``roto.scripted``) for one robot (angles in rad,
+    lengths in m)."""
+
+    swing: dict[str, tuple[float, float, float]]
+    """Swing joint -> (hold, wind-up, strike) target angles."""
+    lean: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """Swing joint -> change of its (wind-up, strike) angle per metre of ball x offset from ``centre_x``."""
+    pose: dict[str, float] = field(default_factory=dict)
+    """Targets of other joints during the whole episode; the rest keep the default pose."""
+    centre_x: float
+    wind_up_steps: int
+    strike_steps: int
+    settle_speed: float
+    """The ball counts as caught when it touches the hand with |vz| below this (m/s) for two steps."""
+
+
+@dataclass(frozen=True, kw_only=True)
 class PairRecord:
     """What belongs to one (task, hand) pair, measured on that hand (docs/robots.md).
 
@@ -31,10 +49,12 @@ class PairRecord:
         warp_peaks: the most contacts and constraint rows any world needed
             (``benchmarks/contact_peaks.py``); the Warp backend sizes its buffers from them
             (``roto.envs.capacity``).
+        script: Bounce: the scripted motion whose bounces are ``reference`` (``roto.scripted``).
     """
 
     reference: float
     warp_peaks: tuple[int, int]
+    script: BounceScript | None = None
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -6,6 +6,7 @@ import pytest
 from roto.envs.capacity import warp_capacity
 from roto.robots import ROBOTS, get_robot, pair_references
 from roto.robots.spec import PairRecord
+from roto.scripted import SCRIPTS
 from roto.tasks import TASKS, get_task
 
 
@@ -15,6 +16,8 @@ def test_every_hand_has_a_measured_record_of_every_task(robot):
     assert set(spec.tasks) == set(TASKS)
     for task, record in spec.tasks.items():
         assert isinstance(record, PairRecord) and record.reference > 0.0
+        assert (record.script is not None) == (task == "bounce")  # Bounce's reference is a scripted motion
+        assert record.script is None or SCRIPTS[robot] is record.script
         assert get_task(task).reference[robot] == record.reference  # the task reads the hand's record
         contacts, rows = record.warp_peaks
         nconmax, njmax = warp_capacity(robot, task)
