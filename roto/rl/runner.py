@@ -19,11 +19,12 @@ from tqdm import tqdm
 from roto.artifact_formats import format_stamp
 from roto.envs.ball_paths import for_path_metrics
 from roto.envs.config import EnvConfig
-from roto.envs.episodes import readable
+from roto.envs.contract import BatchedEnv
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import build_learner, build_model, extra_groups, stacked_sizes
 from roto.rl.checkpoints import load_checkpoint, save_checkpoint
 from roto.rl.config import AgentConfig, to_dict
+from roto.rl.episode_stats import EpisodeStats
 from roto.rl.evaluation import PolicyEvaluator
 from roto.rl.logger import ScalarLogger
 from roto.rl.run_dir import CHECKPOINT_DIR, RunDir, checkpoint_path, first_missing, numbered_checkpoints
@@ -37,34 +38,6 @@ from roto.sim.host_sync import deliberate_host_sync
 
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded with seed + this, so they never replay the training envs' resets."""
-
-
-class EpisodeStats:
-    """Sums of the training episodes that ended during a rollout, kept on the device until read."""
-
-    def __init__(self, names: tuple[str, ...], device: torch.device) -> None:
-        self.names = ("r", "l", *names)
-        self.sums = torch.zeros(len(self.names), dtype=torch.float64, device=device)
-        self.count = torch.zeros((), dtype=torch.float64, device=device)
-
-    def add(self, info: dict[str, Any]) -> None:
-        """Fold in the episodes that ended this step (``info["_episode"]``)."""
-        if "episode" in info:
-            done = info["_episode"].to(torch.float64)
-            episode = info["episode"]
-            self.sums += torch.stack([(episode[n].to(torch.float64) * done).sum() for n in self.names])
-            self.count += done.sum()
-
-    def read(self) -> dict[str, float]:
-        """{"train/episode_<name>": mean} over the ended episodes ({} if none ended); resets the sums."""
-        count = float(self.count)
-        means = (self.sums / max(count, 1.0)).tolist()
-        self.sums.zero_()
-        self.count.zero_()
-        if count == 0:
-            return {}
-        tags = [readable(n) for n in self.names]
-        return {f"train/episode_{tag}": mean for tag, mean in zip(tags, means, strict=True)}
 
 
 class Trainer:
@@ -87,7 +60,7 @@ class Trainer:
         agent: AgentConfig,
         run_dir: str | pathlib.Path,
         tensorboard: bool = True,
-        env_factory: Callable[[EnvConfig], Any] = RotoEnv,
+        env_factory: Callable[[EnvConfig], BatchedEnv] = RotoEnv,
         wandb_project: str | None = None,
     ) -> None:
         if wandb_project is not None:
@@ -110,7 +83,7 @@ class Trainer:
         self.wandb_project = wandb_project
         write_run_config(self.run_dir, settings, agent)
 
-    def _build(self, env_factory: Callable[[EnvConfig], Any], extra: tuple[str, ...]) -> None:
+    def _build(self, env_factory: Callable[[EnvConfig], BatchedEnv], extra: tuple[str, ...]) -> None:
         """The envs, the evaluator, the model and the learner; the counters at zero."""
         settings, agent = self.settings, self.agent
         self.env = env_factory(settings.env_config(extra_groups=extra))
@@ -324,7 +297,7 @@ class Trainer:
         *,
         steps: int | None = None,
         tensorboard: bool = True,
-        env_factory: Callable[[EnvConfig], Any] = RotoEnv,
+        env_factory: Callable[[EnvConfig], BatchedEnv] = RotoEnv,
         wandb_project: str | None = None,
     ) -> Trainer:
         """The run in ``run_dir``: continued from its latest checkpoint when it has one, else created
@@ -362,7 +335,7 @@ class Trainer:
         run_dir: str | pathlib.Path,
         total_steps: int | None = None,
         tensorboard: bool = True,
-        env_factory: Callable[[EnvConfig], Any] = RotoEnv,
+        env_factory: Callable[[EnvConfig], BatchedEnv] = RotoEnv,
         wandb_project: str | None = None,
         *,
         threads: int | None = None,

@@ -1,8 +1,8 @@
 import pytest
 import torch
 
+from roto.rl.episode_stats import EpisodeStats
 from roto.rl.networks import concat_groups
-from roto.rl.runner import EpisodeStats
 from roto.rl.torch_threads import single_torch_thread
 
 
