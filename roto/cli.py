@@ -80,8 +80,14 @@ def _cmd_train(args: argparse.Namespace) -> int:
         trainer = Trainer.resume(args.resume, args.steps, wandb_project=wandb_project, threads=threads)
     else:
         # the env flags are shorthand for env.* overrides, which win over them; all checked before anything is written
-        flags = dict(num_envs=args.num_envs, seed=args.seed, backend=args.backend, device=args.device,
-                     threads=args.threads, touch=args.touch)  # fmt: skip
+        flags = dict(
+            num_envs=args.num_envs,
+            seed=args.seed,
+            backend=args.backend,
+            device=args.device,
+            threads=args.threads,
+            touch=args.touch,
+        )
         steps = args.steps if args.steps is not None else DEFAULT_STEPS
         spec = build_run_spec(args.task, args.robot, args.obs, args.agent_cfg, args.overrides, steps, **flags)
         run_dir = args.run_dir or pathlib.Path("runs") / (
@@ -97,8 +103,11 @@ def _cmd_train(args: argparse.Namespace) -> int:
     try:
         last = trainer.train(progress=not args.no_progress)
     except KeyboardInterrupt as stop:  # Ctrl-C, kill or a time limit's signal: a stop, not an error
-        print(f"roto train: interrupted at update {trainer.update} ({str(stop) or 'at once'}); `roto train --resume "
-              f"{trainer.run_dir}` continues from its latest checkpoint", file=sys.stderr)  # fmt: skip
+        print(
+            f"roto train: interrupted at update {trainer.update} ({str(stop) or 'at once'}); `roto train --resume "
+            f"{trainer.run_dir}` continues from its latest checkpoint",
+            file=sys.stderr,
+        )
         return 130
     plot_learning_curve(trainer.run_dir)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}

@@ -51,8 +51,15 @@ def backend_for(config: EnvConfig, model: mujoco.MjModel) -> Backend:
     if config.backend == "warp":
         nconmax, njmax = warp_capacity(config.robot, config.task)
         capacity = {"nconmax": config.nconmax or nconmax, "njmax": config.njmax or njmax}
-    return make_backend(config.backend, model, config.num_envs, substeps=config.substeps, threads=config.threads,
-                        device=config.device, **capacity)  # fmt: skip
+    return make_backend(
+        config.backend,
+        model,
+        config.num_envs,
+        substeps=config.substeps,
+        threads=config.threads,
+        device=config.device,
+        **capacity,
+    )
 
 
 class RotoEnv:

@@ -32,14 +32,35 @@ FIRST_PAUSE_S = 0.25
 MAX_PAUSE_S = 4.0
 
 STORAGE_METHODS = (
-    "check_trial_is_updatable", "create_new_study", "create_new_trial", "delete_study", "get_all_studies",
-    "get_all_trials", "get_best_trial", "get_n_trials", "get_study_directions", "get_study_id_from_name",
-    "get_study_name_from_id", "get_study_system_attrs", "get_study_user_attrs", "get_trial",
-    "get_trial_id_from_study_id_trial_number", "get_trial_number_from_id", "get_trial_param", "get_trial_params",
-    "get_trial_system_attrs", "get_trial_user_attrs", "remove_session", "set_study_system_attr",
-    "set_study_user_attr", "set_trial_intermediate_value", "set_trial_param", "set_trial_state_values",
-    "set_trial_system_attr", "set_trial_user_attr",
-)  # fmt: skip
+    "check_trial_is_updatable",
+    "create_new_study",
+    "create_new_trial",
+    "delete_study",
+    "get_all_studies",
+    "get_all_trials",
+    "get_best_trial",
+    "get_n_trials",
+    "get_study_directions",
+    "get_study_id_from_name",
+    "get_study_name_from_id",
+    "get_study_system_attrs",
+    "get_study_user_attrs",
+    "get_trial",
+    "get_trial_id_from_study_id_trial_number",
+    "get_trial_number_from_id",
+    "get_trial_param",
+    "get_trial_params",
+    "get_trial_system_attrs",
+    "get_trial_user_attrs",
+    "remove_session",
+    "set_study_system_attr",
+    "set_study_user_attr",
+    "set_trial_intermediate_value",
+    "set_trial_param",
+    "set_trial_state_values",
+    "set_trial_system_attr",
+    "set_trial_user_attr",
+)
 """``optuna.storages.BaseStorage``'s public methods: each one retries on a lost connection."""
 
 

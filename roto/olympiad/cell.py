@@ -82,8 +82,18 @@ def cell_spec(plan: Plan, cell: Cell) -> RunSpec:
     """What a cell trains: the plan's envs and budget, the variant's agent and env overrides for the
     task, the cell's seed (which wins over any ``env.seed`` override)."""
     agent_cfg, overrides = plan.variants[cell.variant].agent_for(cell.task, cell.robot)
-    spec = build_run_spec(cell.task, cell.robot, cell.obs, agent_cfg, overrides, plan.steps, num_envs=plan.num_envs,
-                          threads=plan.threads, backend=plan.backend, device=plan.device)  # fmt: skip
+    spec = build_run_spec(
+        cell.task,
+        cell.robot,
+        cell.obs,
+        agent_cfg,
+        overrides,
+        plan.steps,
+        num_envs=plan.num_envs,
+        threads=plan.threads,
+        backend=plan.backend,
+        device=plan.device,
+    )
     return spec.with_seed(cell.seed)
 
 

@@ -23,13 +23,27 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--storage", default=None, help=STORAGE_HELP)
     p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
     p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running cell's heartbeats")
-    p.add_argument("--reclaim-now", "--reclaim_now", dest="reclaim_now", action="store_true",
-                   help="first fail and retry every running cell (only when no other worker is alive)")  # fmt: skip
-    p.add_argument("--threads", type=int, default=None,
-                   help="C threads stepping each worker's envs (default: the plan's; not part of a cell)")  # fmt: skip
+    p.add_argument(
+        "--reclaim-now",
+        "--reclaim_now",
+        dest="reclaim_now",
+        action="store_true",
+        help="first fail and retry every running cell (only when no other worker is alive)",
+    )
+    p.add_argument(
+        "--threads",
+        type=int,
+        default=None,
+        help="C threads stepping each worker's envs (default: the plan's; not part of a cell)",
+    )
     p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
-    p.add_argument("--dry-run", "--dry_run", dest="dry_run", action="store_true",
-                   help="list the cells, which are done, and the time left; train nothing")  # fmt: skip
+    p.add_argument(
+        "--dry-run",
+        "--dry_run",
+        dest="dry_run",
+        action="store_true",
+        help="list the cells, which are done, and the time left; train nothing",
+    )
     p.set_defaults(func=cmd_olympiad)
     r = sub.add_parser("results", help="tables (markdown, CSV) and learning curves of an Olympiad's cells")
     r.add_argument("source", help="a plan's name or file (its default results folder), or a folder of summaries")
@@ -71,8 +85,19 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         if args.reclaim_now:  # here, once: a worker reclaiming would take its siblings' fresh claims
             reclaim_now(study, storage)
         enqueue_missing(study, plan, results)
-        argv = [args.plan, "--root", args.root, "--results", str(results), "--heartbeat", str(args.heartbeat),
-                "--torch_threads", str(args.torch_threads), "--threads", str(plan.threads)]  # fmt: skip
+        argv = [
+            args.plan,
+            "--root",
+            args.root,
+            "--results",
+            str(results),
+            "--heartbeat",
+            str(args.heartbeat),
+            "--torch_threads",
+            str(args.torch_threads),
+            "--threads",
+            str(plan.threads),
+        ]
         with storage_in_environment(args.storage) as storage_argv:  # never on argv: /proc/PID/cmdline is public
             return launch_workers("olympiad", args.workers, argv + storage_argv)
     torch.set_num_threads(args.torch_threads)
@@ -106,8 +131,10 @@ def headline_so_far(records: list[dict], metric: str, path_metrics: tuple[str, .
         return ""
     last, best = scored[-1], max(scored, key=lambda r: r[f"{metric}_mean"])
     paths = ", ".join(f"{name} {last[f'{name}_mean']:.2f}" for name in path_metrics if f"{name}_mean" in last)
-    return (f"; last evaluation {last[f'{metric}_mean']:.2f} {metric}{f' ({paths})' if paths else ''}, "
-            f"best {best[f'{metric}_mean']:.2f} at {best['env_steps'] / 1e6:.1f} M")  # fmt: skip
+    return (
+        f"; last evaluation {last[f'{metric}_mean']:.2f} {metric}{f' ({paths})' if paths else ''}, "
+        f"best {best[f'{metric}_mean']:.2f} at {best['env_steps'] / 1e6:.1f} M"
+    )
 
 
 def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1) -> str:

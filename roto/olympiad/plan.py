@@ -142,8 +142,10 @@ def load_plan(plan: str) -> Plan:
     data = read_yaml(path, "plan") or {}
     where = f"plan {plan!r}"
     _check_keys(data, PLAN_KEYS, where)
-    numbers = {key: data.get(key, default) for key, default in
-               (("steps", 5_000_000), ("eval_episodes", 100), ("num_envs", 128), ("threads", 1))}  # fmt: skip
+    numbers = {
+        key: data.get(key, default)
+        for key, default in (("steps", 5_000_000), ("eval_episodes", 100), ("num_envs", 128), ("threads", 1))
+    }
     for key, value in numbers.items():
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ValueError(f"{where}: {key} must be an integer >= 1, got {value!r}")
@@ -162,8 +164,15 @@ def load_plan(plan: str) -> Plan:
     backend, device = str(data.get("backend", "cpu")), str(data.get("device", "cpu"))
     if backend not in BACKENDS:
         raise ValueError(f"{where}: unknown backend {backend!r}; valid backends: {list(BACKENDS)}")
-    return Plan(name=path.stem, variants=variants, cells=tuple(cells), backend=backend, device=device,
-                description=str(data.get("description", "")), **numbers)  # fmt: skip
+    return Plan(
+        name=path.stem,
+        variants=variants,
+        cells=tuple(cells),
+        backend=backend,
+        device=device,
+        description=str(data.get("description", "")),
+        **numbers,
+    )
 
 
 def _check_keys(data: Any, valid: set[str], where: str) -> None:
@@ -198,8 +207,9 @@ def _grid_cells(grid: Any, variants: dict[str, Variant], where: str) -> list[Cel
             raise ValueError(f"{where}: {key} must be a non-empty list, got {values!r}")
         for value in values if key != "seeds" else ():
             if value not in valid[key]:
-                raise ValueError(f"{where}: unknown {key[:-1] if key != 'obs' else 'obs mode'} {value!r}; "
-                                 f"valid {key}: {valid[key]}")  # fmt: skip
+                raise ValueError(
+                    f"{where}: unknown {key[:-1] if key != 'obs' else 'obs mode'} {value!r}; valid {key}: {valid[key]}"
+                )
     for seed in grid["seeds"]:
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise ValueError(f"{where}: seeds must be integers >= 0, got {seed!r}")

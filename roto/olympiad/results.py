@@ -140,8 +140,14 @@ def scores_by_cell(summaries: Iterable[dict], policy: str = "final") -> dict[Key
 def cell_statistics(scores: np.ndarray, seed: int = 0) -> dict[str, float]:
     """Mean, std (population), IQM and its 95 % stratified bootstrap interval of one cell's seeds."""
     low, high = stratified_bootstrap_ci(scores[:, None], seed=seed)
-    return {"n": int(scores.size), "mean": float(scores.mean()), "std": float(scores.std()), "iqm": iqm(scores),
-            "iqm_low": low, "iqm_high": high}  # fmt: skip
+    return {
+        "n": int(scores.size),
+        "mean": float(scores.mean()),
+        "std": float(scores.std()),
+        "iqm": iqm(scores),
+        "iqm_low": low,
+        "iqm_high": high,
+    }
 
 
 def improvements(scores: dict[Key, np.ndarray]) -> list[tuple[str, str, str, str, str, float]]:
@@ -182,8 +188,10 @@ def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None, 
     tasks = current  # a reference stands only beside scores of the task it was measured on
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for robot in robots:
-        cells = [_format(cell_statistics(scores[key]) if (key := (t, robot, o, v)) in scores else None)
-                 for t, o, v in columns]  # fmt: skip
+        cells = [
+            _format(cell_statistics(scores[key]) if (key := (t, robot, o, v)) in scores else None)
+            for t, o, v in columns
+        ]
         refs = [f"{get_task(t).reference[robot]}" if robot in get_task(t).reference else "" for t in tasks]
         lines.append("| " + " | ".join([robot, *cells, *refs]) + " |")
     reference = []
@@ -230,8 +238,12 @@ def path_metric_table(summaries: list[dict]) -> list[str]:
         if not names:
             continue
         header = ["cell", f"{metric(task)} (best.pt)", *names]
-        lines += [f"## best policy, {task}: path metrics beside the headline metric, per seed", "",
-                  "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]  # fmt: skip
+        lines += [
+            f"## best policy, {task}: path metrics beside the headline metric, per seed",
+            "",
+            "| " + " | ".join(header) + " |",
+            "|" + "---|" * len(header),
+        ]
         for s in sorted(summaries, key=lambda s: (s["robot"], s["obs"], s["variant"], s["seed"])):
             if s["task"] == task:
                 best = with_derived_means(task, s["best"])
@@ -246,12 +258,42 @@ def write_csv(scores: dict[Key, np.ndarray], path: pathlib.Path, policy: str) ->
     """One row per cell: its statistics and its seeds' scores."""
     with replacing(path) as temporary, temporary.open("w", newline="") as f:
         writer = csv.writer(f)
-        writer.writerow(["policy", "task", "robot", "obs", "variant", "metric", "n", "mean", "std", "iqm",
-                         "iqm_ci95_low", "iqm_ci95_high", "scores"])  # fmt: skip
+        writer.writerow(
+            [
+                "policy",
+                "task",
+                "robot",
+                "obs",
+                "variant",
+                "metric",
+                "n",
+                "mean",
+                "std",
+                "iqm",
+                "iqm_ci95_low",
+                "iqm_ci95_high",
+                "scores",
+            ]
+        )
         for (task, robot, obs, variant), runs in scores.items():
             s = cell_statistics(runs)
-            writer.writerow([policy, task, robot, obs, variant, metric(task), s["n"], s["mean"], s["std"], s["iqm"],
-                             s["iqm_low"], s["iqm_high"], " ".join(f"{v:.4g}" for v in runs)])  # fmt: skip
+            writer.writerow(
+                [
+                    policy,
+                    task,
+                    robot,
+                    obs,
+                    variant,
+                    metric(task),
+                    s["n"],
+                    s["mean"],
+                    s["std"],
+                    s["iqm"],
+                    s["iqm_low"],
+                    s["iqm_high"],
+                    " ".join(f"{v:.4g}" for v in runs),
+                ]
+            )
 
 
 Curves = dict[tuple[str, str], dict[str, list]]  # {(task, robot): {"obs / variant": [records of each seed]}}
@@ -271,8 +313,11 @@ def curves_by_pair(summaries: list[dict], records: Callable[[dict], list[dict]])
 def action_std_records(summary: dict) -> list[dict]:
     """The policy's action std in training at each evaluation (``training``; empty in summaries
     written before they kept it), as records ``plot_variants`` reads."""
-    return [{"env_steps": r["env_steps"], "action_std_mean": r["ppo/action_std"]}
-            for r in summary.get("training", []) if "ppo/action_std" in r]  # fmt: skip
+    return [
+        {"env_steps": r["env_steps"], "action_std_mean": r["ppo/action_std"]}
+        for r in summary.get("training", [])
+        if "ppo/action_std" in r
+    ]
 
 
 def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pathlib.Path]:
@@ -286,8 +331,13 @@ def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pa
         paths.append(path)
     for (task, robot), curves in curves_by_pair(summaries, action_std_records).items():
         path = out / f"action_std_{task}_{robot}.png"
-        plot_variants(curves, "action_std", path, title=f"{task} / {robot} ({label})",
-                      ylabel="policy's action std in training (mean over seeds)")  # fmt: skip
+        plot_variants(
+            curves,
+            "action_std",
+            path,
+            title=f"{task} / {robot} ({label})",
+            ylabel="policy's action std in training (mean over seeds)",
+        )
         paths.append(path)
     return paths
 

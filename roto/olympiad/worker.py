@@ -157,8 +157,12 @@ def cell_status(plan: Plan, root: str, results: pathlib.Path, storage_url: str |
     study = find_study(pathlib.Path(root) / plan.name, study_name(plan), storage_url)
     if study is None:
         return status
-    by_state = (("failed", (TrialState.FAIL,)), ("waiting", (TrialState.WAITING,)),
-                ("running", (TrialState.RUNNING,)), ("done", (TrialState.COMPLETE,)))  # fmt: skip
+    by_state = (
+        ("failed", (TrialState.FAIL,)),
+        ("waiting", (TrialState.WAITING,)),
+        ("running", (TrialState.RUNNING,)),
+        ("done", (TrialState.COMPLETE,)),
+    )
     for label, states in by_state:  # later labels win: a cell failed once and now running is running
         for name in cell_trials(study, states):
             if name in status and status[name] != "done":

@@ -133,8 +133,13 @@ class Trainer:
             self.obs, _ = self.env.reset(seed=self.settings.env.seed)
         logger = self._open_logger()
         env = self.settings.env
-        bar = tqdm(total=self.total_updates * self.steps_per_update, initial=self.env_steps, disable=not progress,
-                   unit="step", desc=f"{env.task}/{env.robot}/{env.obs_mode}")  # fmt: skip
+        bar = tqdm(
+            total=self.total_updates * self.steps_per_update,
+            initial=self.env_steps,
+            disable=not progress,
+            unit="step",
+            desc=f"{env.task}/{env.robot}/{env.obs_mode}",
+        )
         try:
             with StopRequests() as stop:
                 while self.update < self.total_updates:
@@ -148,8 +153,13 @@ class Trainer:
                     self.update += 1
                     self.env_steps += self.steps_per_update
                     self.train_seconds += t_end - t_start
-                    scalars.update({"perf/update_s": t_end - t_update, "perf/train_wall_s": self.train_seconds,
-                                    "perf/steps_per_s": self.steps_per_update / (t_end - t_start)})  # fmt: skip
+                    scalars.update(
+                        {
+                            "perf/update_s": t_end - t_update,
+                            "perf/train_wall_s": self.train_seconds,
+                            "perf/steps_per_s": self.steps_per_update / (t_end - t_start),
+                        }
+                    )
                     scalars.update(self.episodes.read())
                     if self.update % self.agent.run.eval_every == 0 or self.update == self.total_updates:
                         scalars.update(self._evaluate())

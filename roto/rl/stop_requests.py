@@ -61,8 +61,11 @@ class StopRequests:
         if self.requested:
             raise KeyboardInterrupt(f"{name} after {self.signal_name}: stopped at once")
         self.signal_name = name
-        print(f"roto: {name}: stopping after this update, with a checkpoint (send it again to stop now)",
-              file=sys.stderr, flush=True)  # fmt: skip
+        print(
+            f"roto: {name}: stopping after this update, with a checkpoint (send it again to stop now)",
+            file=sys.stderr,
+            flush=True,
+        )
 
 
 def interrupt_on_sigterm() -> None:

@@ -82,8 +82,9 @@ def _box(body: mujoco.MjsBody, half: tuple[float, float, float], centre: tuple[f
 
 def _tip(body: mujoco.MjsBody, capsule: tuple[float, float, float]) -> None:
     radius, half, z = capsule
-    body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[radius, half, 0.0], pos=[0.0, 0.0, z],
-                  rgba=list(TIP_RGBA), mass=0.0)  # fmt: skip
+    body.add_geom(
+        type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[radius, half, 0.0], pos=[0.0, 0.0, z], rgba=list(TIP_RGBA), mass=0.0
+    )
 
 
 def _link(parent: mujoco.MjsBody, name: str, pos, quat, mass: float, joint: str, axis, limits) -> mujoco.MjsBody:
@@ -103,8 +104,16 @@ def _finger(palm: mujoco.MjsBody, finger: str) -> None:
     )
     _box(body, (LINK_HALF_THICKNESS, LINK_HALF_WIDTH, FINGER_BOX["base"]), (0.0, 0.0, FINGER_BOX["base"]))
     for index, link in enumerate(("proximal", "medial", "distal"), start=1):
-        body = _link(body, f"{finger}_{link}", (0.0, 0.0, LINK_OFFSETS[link]), (1, 0, 0, 0), FINGER_MASSES[link],
-                     f"{finger}j{index}", (0, 1, 0), FINGER_RANGES[link])  # fmt: skip
+        body = _link(
+            body,
+            f"{finger}_{link}",
+            (0.0, 0.0, LINK_OFFSETS[link]),
+            (1, 0, 0, 0),
+            FINGER_MASSES[link],
+            f"{finger}j{index}",
+            (0, 1, 0),
+            FINGER_RANGES[link],
+        )
         _box(body, (LINK_HALF_THICKNESS, LINK_HALF_WIDTH, FINGER_BOX[link]), (0.0, 0.0, FINGER_BOX[link]))
     tip = body.add_body(name=f"{finger}_tip", mass=FINGER_MASSES["tip"])
     tip.explicitinertial = True
@@ -113,12 +122,28 @@ def _finger(palm: mujoco.MjsBody, finger: str) -> None:
 
 
 def _thumb(palm: mujoco.MjsBody) -> None:
-    body = _link(palm, "th_base", THUMB_BASE_POS, THUMB_BASE_QUAT, THUMB_MASSES["base"], "thj0",
-                 THUMB_AXES["base"], THUMB_RANGES["base"])  # fmt: skip
+    body = _link(
+        palm,
+        "th_base",
+        THUMB_BASE_POS,
+        THUMB_BASE_QUAT,
+        THUMB_MASSES["base"],
+        "thj0",
+        THUMB_AXES["base"],
+        THUMB_RANGES["base"],
+    )
     _box(body, *THUMB_BOXES["base"])
     for index, link in enumerate(("proximal", "medial", "distal"), start=1):
-        body = _link(body, f"th_{link}", THUMB_OFFSETS[link], (1, 0, 0, 0), THUMB_MASSES[link], f"thj{index}",
-                     THUMB_AXES[link], THUMB_RANGES[link])  # fmt: skip
+        body = _link(
+            body,
+            f"th_{link}",
+            THUMB_OFFSETS[link],
+            (1, 0, 0, 0),
+            THUMB_MASSES[link],
+            f"thj{index}",
+            THUMB_AXES[link],
+            THUMB_RANGES[link],
+        )
         _box(body, *THUMB_BOXES[link])
     tip = body.add_body(name="th_tip", mass=THUMB_MASSES["tip"])
     tip.explicitinertial = True
@@ -137,8 +162,14 @@ def load_allegro_spec() -> mujoco.MjSpec:
     palm.explicitinertial = True
     palm.ipos = [0.0, 0.0, -0.0475]
     palm.inertia = [1e-4, 1e-4, 1e-4]
-    palm.add_geom(name="palm_box", type=mujoco.mjtGeom.mjGEOM_BOX, size=list(PALM_BOX[0]), pos=list(PALM_BOX[1]),
-                  rgba=list(LINK_RGBA), mass=0.0)  # fmt: skip
+    palm.add_geom(
+        name="palm_box",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=list(PALM_BOX[0]),
+        pos=list(PALM_BOX[1]),
+        rgba=list(LINK_RGBA),
+        mass=0.0,
+    )
     for finger in FINGER_BASES:
         _finger(palm, finger)
     _thumb(palm)

@@ -70,13 +70,24 @@ _ACTUATED = tuple(
     _j(n)
     for n in (
         "wrist",
-        "thumb_mcp", "thumb_abd", "thumb_pip", "thumb_dip",
-        "index_abd", "index_mcp", "index_pip",
-        "middle_abd", "middle_mcp", "middle_pip",
-        "ring_abd", "ring_mcp", "ring_pip",
-        "pinky_abd", "pinky_mcp", "pinky_pip",
+        "thumb_mcp",
+        "thumb_abd",
+        "thumb_pip",
+        "thumb_dip",
+        "index_abd",
+        "index_mcp",
+        "index_pip",
+        "middle_abd",
+        "middle_mcp",
+        "middle_pip",
+        "ring_abd",
+        "ring_mcp",
+        "ring_pip",
+        "pinky_abd",
+        "pinky_mcp",
+        "pinky_pip",
     )
-)  # fmt: skip
+)
 
 # ORCA's wrist is strong (kp 100): it winds the fingers down (positive wrist) and strikes back up.
 ORCA_BOUNCE = BounceScript(

@@ -50,14 +50,28 @@ def _j(name: str) -> str:
 _ACTUATED = tuple(
     _j(n)
     for n in (
-        "WRJ1", "WRJ0",
-        "FFJ3", "FFJ2", "FFJ1",
-        "MFJ3", "MFJ2", "MFJ1",
-        "RFJ3", "RFJ2", "RFJ1",
-        "LFJ4", "LFJ3", "LFJ2", "LFJ1",
-        "THJ4", "THJ3", "THJ2", "THJ1", "THJ0",
+        "WRJ1",
+        "WRJ0",
+        "FFJ3",
+        "FFJ2",
+        "FFJ1",
+        "MFJ3",
+        "MFJ2",
+        "MFJ1",
+        "RFJ3",
+        "RFJ2",
+        "RFJ1",
+        "LFJ4",
+        "LFJ3",
+        "LFJ2",
+        "LFJ1",
+        "THJ4",
+        "THJ3",
+        "THJ2",
+        "THJ1",
+        "THJ0",
     )
-)  # fmt: skip
+)
 
 SHADOW_BOUNCE = BounceScript(
     swing={"robot0:WRJ0": (0.029, -0.663, 0.337)},

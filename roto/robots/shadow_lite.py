@@ -77,22 +77,43 @@ def load_shadow_lite_spec() -> mujoco.MjSpec:
 _ACTUATED = tuple(
     _j(n)
     for n in (
-        "FFJ3", "FFJ2", "FFJ1",
-        "MFJ3", "MFJ2", "MFJ1",
-        "RFJ3", "RFJ2", "RFJ1",
-        "THJ4", "THJ3", "THJ1", "THJ0",
+        "FFJ3",
+        "FFJ2",
+        "FFJ1",
+        "MFJ3",
+        "MFJ2",
+        "MFJ1",
+        "RFJ3",
+        "RFJ2",
+        "RFJ1",
+        "THJ4",
+        "THJ3",
+        "THJ1",
+        "THJ0",
     )
-)  # fmt: skip
+)
 
 _OBSERVED = tuple(
     _j(n)
     for n in (
-        "FFJ3", "FFJ2", "FFJ1", "FFJ0",
-        "MFJ3", "MFJ2", "MFJ1", "MFJ0",
-        "RFJ3", "RFJ2", "RFJ1", "RFJ0",
-        "THJ4", "THJ3", "THJ1", "THJ0",
+        "FFJ3",
+        "FFJ2",
+        "FFJ1",
+        "FFJ0",
+        "MFJ3",
+        "MFJ2",
+        "MFJ1",
+        "MFJ0",
+        "RFJ3",
+        "RFJ2",
+        "RFJ1",
+        "RFJ0",
+        "THJ4",
+        "THJ3",
+        "THJ1",
+        "THJ0",
     )
-)  # fmt: skip
+)
 
 # The Lite has no wrist: its fingers extend (wind-up: the ball rolls out onto them, the hand being
 # tilted towards the fingertips), then flick up at the knuckles (J2) and middle joints (J1) while

@@ -17,8 +17,23 @@ STORAGE_HELP = (
 DEFAULTS = sweep_defaults()
 """The flags' defaults: ``SweepSettings``' own, written once."""
 
-RUN_FLAGS = ("task", "robot", "obs", "agent_cfg", "space", "objective", "trials", "startup", "steps", "warmup_steps",
-             "num_envs", "threads", "root", "storage", "heartbeat")  # fmt: skip
+RUN_FLAGS = (
+    "task",
+    "robot",
+    "obs",
+    "agent_cfg",
+    "space",
+    "objective",
+    "trials",
+    "startup",
+    "steps",
+    "warmup_steps",
+    "num_envs",
+    "threads",
+    "root",
+    "storage",
+    "heartbeat",
+)
 """The ``SweepSettings`` fields the command line sets (besides the study name and overrides)."""
 
 
@@ -31,43 +46,8 @@ def _study_args(parser: argparse.ArgumentParser, required: bool) -> None:
 def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     """Register ``roto sweep`` and its ``export`` and ``show`` subcommands."""
     p = sub.add_parser("sweep", help="tune an agent with Optuna (TPE, median pruning), on one or many machines")
-    p.add_argument("--task", default=DEFAULTS["task"])
-    p.add_argument("--robot", default=DEFAULTS["robot"])
-    p.add_argument("--obs", default=DEFAULTS["obs"], help="blind, state or proprio")
-    p.add_argument(
-        "--agent_cfg", "--agent-cfg", dest="agent_cfg", default=DEFAULTS["agent_cfg"], help="base agent config"
-    )
-    p.add_argument(
-        "--space",
-        default=DEFAULTS["space"],
-        help="search space: a name in roto/configs/sweep/ (default %(default)s) or a YAML file",
-    )
-    p.add_argument("--objective", default=DEFAULTS["objective"],
-                   help="what trials maximise: the best evaluation's mean return (default), 'metric' (the task's "
-                        "headline metric, Baoding: rotations), or another metric the task's evaluations report "
-                        "(Baoding: round_rotations, the rotations its pair's net turning backs), with the return "
-                        "breaking ties")  # fmt: skip
-    p.add_argument("--trials", type=int, default=DEFAULTS["trials"], help="trials that finish (complete or pruned)")
-    p.add_argument(
-        "--startup", type=int, default=DEFAULTS["startup"], help="random start-up trials (also the pruner's wait)"
-    )
-    p.add_argument("--steps", type=int, default=DEFAULTS["steps"], help="env steps per trial")
-    p.add_argument(
-        "--warmup_steps", type=int, default=DEFAULTS["warmup_steps"], help="env steps before pruning (default steps/5)"
-    )
-    p.add_argument("--num_envs", type=int, default=DEFAULTS["num_envs"])
-    p.add_argument("--threads", type=int, default=DEFAULTS["threads"], help="C threads stepping each worker's envs")
-    p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
-    p.add_argument(
-        "--heartbeat", type=float, default=DEFAULTS["heartbeat"], help="seconds between a running trial's heartbeats"
-    )
-    p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
-    p.add_argument("--enqueue_base", "--enqueue-base", dest="enqueue_base", action="store_true",
-                   help="a new study's first trial: the base config's values of the searched parameters")  # fmt: skip
-    p.add_argument("--reclaim-now", "--reclaim_now", dest="reclaim_now", action="store_true",
-                   help="first fail and retry every running trial (only when no other worker is alive)")  # fmt: skip
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="section.key=value",
-                   help="override every trial gets (env.num_envs=64, ppo.gamma=0.99); repeatable")  # fmt: skip
+    _search_args(p)
+    _worker_args(p)
     _study_args(p, required=False)
     p.set_defaults(func=cmd_sweep)
     actions = p.add_subparsers(dest="sweep_command", metavar="{export,show}")
@@ -79,6 +59,70 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     show = actions.add_parser("show", help="print the trials table and the parameter importances")
     _study_args(show, required=True)
     show.set_defaults(func=cmd_show)
+
+
+def _search_args(p: argparse.ArgumentParser) -> None:
+    """What the study searches and trains: the ``SweepSettings`` of its identity."""
+    p.add_argument("--task", default=DEFAULTS["task"])
+    p.add_argument("--robot", default=DEFAULTS["robot"])
+    p.add_argument("--obs", default=DEFAULTS["obs"], help="blind, state or proprio")
+    p.add_argument(
+        "--agent_cfg", "--agent-cfg", dest="agent_cfg", default=DEFAULTS["agent_cfg"], help="base agent config"
+    )
+    p.add_argument(
+        "--space",
+        default=DEFAULTS["space"],
+        help="search space: a name in roto/configs/sweep/ (default %(default)s) or a YAML file",
+    )
+    p.add_argument(
+        "--objective",
+        default=DEFAULTS["objective"],
+        help="what trials maximise: the best evaluation's mean return (default), 'metric' (the task's "
+        "headline metric, Baoding: rotations), or another metric the task's evaluations report "
+        "(Baoding: round_rotations, the rotations its pair's net turning backs), with the return "
+        "breaking ties",
+    )
+    p.add_argument("--trials", type=int, default=DEFAULTS["trials"], help="trials that finish (complete or pruned)")
+    p.add_argument(
+        "--startup", type=int, default=DEFAULTS["startup"], help="random start-up trials (also the pruner's wait)"
+    )
+    p.add_argument("--steps", type=int, default=DEFAULTS["steps"], help="env steps per trial")
+    p.add_argument(
+        "--warmup_steps", type=int, default=DEFAULTS["warmup_steps"], help="env steps before pruning (default steps/5)"
+    )
+    p.add_argument("--num_envs", type=int, default=DEFAULTS["num_envs"])
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="section.key=value",
+        help="override every trial gets (env.num_envs=64, ppo.gamma=0.99); repeatable",
+    )
+
+
+def _worker_args(p: argparse.ArgumentParser) -> None:
+    """How this machine's workers run the study."""
+    p.add_argument("--threads", type=int, default=DEFAULTS["threads"], help="C threads stepping each worker's envs")
+    p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
+    p.add_argument(
+        "--heartbeat", type=float, default=DEFAULTS["heartbeat"], help="seconds between a running trial's heartbeats"
+    )
+    p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
+    p.add_argument(
+        "--enqueue_base",
+        "--enqueue-base",
+        dest="enqueue_base",
+        action="store_true",
+        help="a new study's first trial: the base config's values of the searched parameters",
+    )
+    p.add_argument(
+        "--reclaim-now",
+        "--reclaim_now",
+        dest="reclaim_now",
+        action="store_true",
+        help="first fail and retry every running trial (only when no other worker is alive)",
+    )
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
@@ -103,13 +147,18 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
         study = open_study(settings)[0]
         if study.trials:  # the same command that started the study continues it
-            print(f"--enqueue_base: study {settings.study!r} already has {len(study.trials)} trials, so the base "
-                  "config (only ever a new study's first trial) is not enqueued again; continuing the study",
-                  file=sys.stderr)  # fmt: skip
+            print(
+                f"--enqueue_base: study {settings.study!r} already has {len(study.trials)} trials, so the base "
+                "config (only ever a new study's first trial) is not enqueued again; continuing the study",
+                file=sys.stderr,
+            )
         else:
             inside, outside = enqueue_base(study, settings, space)
-            print(f"enqueued the base config as the first trial: {inside}"
-                  + (f"; outside the space, drawn instead: {outside}" if outside else ""), file=sys.stderr)  # fmt: skip
+            print(
+                f"enqueued the base config as the first trial: {inside}"
+                + (f"; outside the space, drawn instead: {outside}" if outside else ""),
+                file=sys.stderr,
+            )
     if args.workers > 1:
         load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)  # before creating
         study, storage = open_study(settings)  # create it once, so the workers only join

@@ -73,8 +73,9 @@ class SweepSettings:
 
     def base_env(self, seed: int = 0) -> EnvConfig:
         """The trials' env config before overrides and searched env parameters."""
-        return EnvConfig(task=self.task, robot=self.robot, obs_mode=self.obs, num_envs=self.num_envs, seed=seed,
-                         threads=self.threads)  # fmt: skip
+        return EnvConfig(
+            task=self.task, robot=self.robot, obs_mode=self.obs, num_envs=self.num_envs, seed=seed, threads=self.threads
+        )
 
     def identity(self) -> dict[str, Any]:
         """The settings that define the study's trials (stored on the study, checked on joining)."""

@@ -80,9 +80,15 @@ def trial_spec(settings: SweepSettings, params: dict[str, Any], seed: int) -> Ru
     """What a trial trains: the study's run with its fixed overrides, then the drawn parameters; the
     trial's seed wins over any ``env.seed`` override."""
     spec = build_run_spec(
-        settings.task, settings.robot, settings.obs, settings.agent_cfg, [*settings.overrides, *as_overrides(params)],
-        settings.steps, num_envs=settings.num_envs, threads=settings.threads,
-    )  # fmt: skip
+        settings.task,
+        settings.robot,
+        settings.obs,
+        settings.agent_cfg,
+        [*settings.overrides, *as_overrides(params)],
+        settings.steps,
+        num_envs=settings.num_envs,
+        threads=settings.threads,
+    )
     return spec.with_seed(seed)
 
 

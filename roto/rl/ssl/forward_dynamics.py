@@ -63,8 +63,9 @@ class ForwardDynamics:
         width = model.latent_width
         last = config.projector[-1] if config.projector else width
         projector = nn.Sequential(mlp([width, *config.projector], layer_norm=False), nn.Linear(last, width))
-        self.heads = nn.ModuleDict({"latent_model": ResidualLatentModel(width, num_actions, config.latent_model),
-                                    "projector": projector})  # fmt: skip
+        self.heads = nn.ModuleDict(
+            {"latent_model": ResidualLatentModel(width, num_actions, config.latent_model), "projector": projector}
+        )
         self.heads.to(next(model.parameters()).device)
         self.target_encoder = copy.deepcopy(model.encoder).requires_grad_(False)
         self.optimizer = torch.optim.Adam([*self.heads.parameters(), *model.encoder.parameters()], lr=config.lr)
