@@ -8,6 +8,7 @@ import json
 import pathlib
 from typing import TYPE_CHECKING
 
+from roto.jobs.flags import add_worker_flags
 from roto.sweep.command import STORAGE_HELP
 
 if TYPE_CHECKING:
@@ -21,22 +22,13 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--root", default="runs/olympiad", help="where run directories go (<root>/<plan>/<cell>)")
     p.add_argument("--results", default=None, help="folder of the cells' summaries (default <root>/<plan>/results)")
     p.add_argument("--storage", default=None, help=STORAGE_HELP)
-    p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
-    p.add_argument("--heartbeat", type=float, default=30.0, help="seconds between a running cell's heartbeats")
-    p.add_argument(
-        "--reclaim-now",
-        "--reclaim_now",
-        dest="reclaim_now",
-        action="store_true",
-        help="first fail and retry every running cell (only when no other worker is alive)",
-    )
+    add_worker_flags(p, "cell")
     p.add_argument(
         "--threads",
         type=int,
         default=None,
         help="C threads stepping each worker's envs (default: the plan's; not part of a cell)",
     )
-    p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
     p.add_argument(
         "--dry-run",
         "--dry_run",

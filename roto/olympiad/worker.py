@@ -24,6 +24,7 @@ from optuna.trial import TrialState
 
 from roto.envs.roto_env import RotoEnv
 from roto.jobs.claims import run_claimed, tell_failed
+from roto.jobs.flags import HEARTBEAT_S
 from roto.jobs.optuna_ids import storage_id
 from roto.jobs.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 from roto.olympiad.cell import code_commit, run_cell, summary_path
@@ -113,7 +114,7 @@ def run_olympiad_worker(
     root: str = "runs/olympiad",
     results: str | pathlib.Path | None = None,
     storage_url: str | None = None,
-    heartbeat: float = 30.0,
+    heartbeat: float = HEARTBEAT_S,
     env_factory: Callable[[Any], Any] = RotoEnv,
     reclaim: bool = False,
 ) -> int:

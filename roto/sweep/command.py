@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 
+from roto.jobs.flags import add_worker_flags
 from roto.sweep.settings import sweep_defaults
 
 STORAGE_HELP = (
@@ -104,24 +105,13 @@ def _search_args(p: argparse.ArgumentParser) -> None:
 def _worker_args(p: argparse.ArgumentParser) -> None:
     """How this machine's workers run the study."""
     p.add_argument("--threads", type=int, default=DEFAULTS["threads"], help="C threads stepping each worker's envs")
-    p.add_argument("--torch_threads", type=int, default=1, help="torch threads of each worker's update")
-    p.add_argument(
-        "--heartbeat", type=float, default=DEFAULTS["heartbeat"], help="seconds between a running trial's heartbeats"
-    )
-    p.add_argument("--workers", type=int, default=1, help="worker processes to run here (default 1)")
+    add_worker_flags(p, "trial")
     p.add_argument(
         "--enqueue_base",
         "--enqueue-base",
         dest="enqueue_base",
         action="store_true",
         help="a new study's first trial: the base config's values of the searched parameters",
-    )
-    p.add_argument(
-        "--reclaim-now",
-        "--reclaim_now",
-        dest="reclaim_now",
-        action="store_true",
-        help="first fail and retry every running trial (only when no other worker is alive)",
     )
 
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from roto.envs.config import EnvConfig
+from roto.jobs.flags import HEARTBEAT_S
 from roto.tasks import get_task
 
 STUDY_NAME = re.compile(r"[A-Za-z0-9._-]+")
@@ -51,7 +52,7 @@ class SweepSettings:
     root: str = "runs/sweeps"
     storage: str | None = None
     """Database URL; None: the journal file in the study's folder."""
-    heartbeat: float = 30.0
+    heartbeat: float = HEARTBEAT_S
     """Seconds between a running trial's heartbeats; a trial silent for 4 of them is declared dead."""
 
     def __post_init__(self) -> None:
