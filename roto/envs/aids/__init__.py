@@ -10,7 +10,16 @@ from roto.envs.aids.replayed_starts import ReplayedStarts
 from roto.envs.aids.round_swaps import RoundSwaps
 from roto.envs.aids.tolerance import ToleranceAid
 
-__all__ = ["AidHost", "StepContext", "TrainingAid", "build_aids"]
+__all__ = [
+    "AidHost",
+    "RecordedEvents",
+    "ReplayedStarts",
+    "RoundSwaps",
+    "StepContext",
+    "ToleranceAid",
+    "TrainingAid",
+    "build_aids",
+]
 
 
 def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
@@ -22,8 +31,7 @@ def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
     if replay is not None:
         aids.append(replay)
     if config.replay_record_lead > 0:  # the config check guarantees replayed starts beside it
-        replay.recorded = RecordedEvents(host, tuple(replay.bank.task))
-        aids.append(replay.recorded)
+        aids.append(replay.record_own_events(host))
     if config.tolerance_start > 0.0:
         aids.append(ToleranceAid(host))
     if config.swap_min_turn > 0.0:

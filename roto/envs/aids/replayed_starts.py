@@ -28,7 +28,13 @@ class ReplayedStarts(TrainingAid):
         self.bank, self.share, self.device = bank.to(host.device), config.replay_share, host.device
         self.first_frame = host.first_frame
         self.recorded: RecordedEvents | None = None
-        """The envs' own recorded states, drawn alike beside the bank's (set by ``build_aids``)."""
+        """The envs' own recorded states, drawn alike beside the bank's (``record_own_events``)."""
+
+    def record_own_events(self, host: AidHost) -> RecordedEvents:
+        """The aid that records the envs' own states before each event, with this bank's task
+        fields; its states are drawn from beside the bank's from now on."""
+        self.recorded = RecordedEvents(host, tuple(self.bank.task))
+        return self.recorded
 
     def start_task_fields(self) -> tuple[str, ...]:
         """The task state fields the bank's states were recorded in (none while nothing replays)."""
