@@ -17,6 +17,7 @@ TRAINING_AID_FIELDS = (
     "tolerance_start",
     "tolerance_target",
     "swap_min_turn",
+    "turn_reward",
 )
 """The env fields that are training aids: a run's training envs may set them; evaluation and the
 benchmark never do (``EnvConfig.without_training_aids``)."""
@@ -70,6 +71,10 @@ class EnvConfig:
             paid swap, the same way round as the episode's first (0.25: a quarter turn; a pair
             carried round turns half a turn a swap, one swung out and back is paid once an
             episode). Swaps still count as roto counts them (``roto.tasks.round_swaps``).
+        turn_reward: a training aid for Baoding (0: off): reward per turn the magnitude of the
+            pair's net turning this episode grows (given back as it shrinks: a potential-based
+            shaping term, "turn"), so a pair carried round earns it and a swing out and back does
+            not (``roto.tasks.round_swaps.turn_shaping``).
     """
 
     task: str
@@ -97,6 +102,7 @@ class EnvConfig:
     tolerance_start: float = 0.0
     tolerance_target: float = 1.0
     swap_min_turn: float = 0.0
+    turn_reward: float = 0.0
 
     def __post_init__(self) -> None:
         """Reject impossible values with a message naming the value and the valid choices."""
@@ -131,7 +137,7 @@ class EnvConfig:
                 raise ValueError(f"{name} must be an integer >= 1 or None, got {value!r}")
         self._check_replay()
         self._check_tolerance()
-        self._check_swap_min_turn()
+        self._check_turn_aids()
         self._check_device()
 
     def without_training_aids(self) -> EnvConfig:
@@ -175,7 +181,7 @@ class EnvConfig:
                 f"got {start}, {target}"
             )
 
-    def _check_swap_min_turn(self) -> None:
+    def _check_turn_aids(self) -> None:
         from roto.tasks import get_task
 
         value = self.swap_min_turn
@@ -183,6 +189,11 @@ class EnvConfig:
             raise ValueError(f"swap_min_turn must be a number of turns in [0, 0.5] (0: off), got {value!r}")
         if value > 0.0 and "swap_min_turn" not in get_task(self.task).parameters:
             raise ValueError(f"swap_min_turn applies to a task with swaps (baoding); task {self.task!r} has none")
+        value = self.turn_reward
+        if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value <= 1000.0:
+            raise ValueError(f"turn_reward must be a reward per turn in [0, 1000] (0: off), got {value!r}")
+        if value > 0.0 and "turn_reward" not in get_task(self.task).parameters:
+            raise ValueError(f"turn_reward applies to a task with a ball pair (baoding); task {self.task!r} has none")
 
     def _check_device(self) -> None:
         device = str(self.device)

@@ -8,6 +8,7 @@ its first episode, and appends one JSON line to ``<run_dir>/evaluations.jsonl``.
 from __future__ import annotations
 
 import json
+import math
 import pathlib
 import time
 import warnings
@@ -31,6 +32,25 @@ def summarize(per_episode: dict[str, list[float]]) -> dict[str, float]:
         summary[f"{name}_mean"] = float(t.mean())
         summary[f"{name}_std"] = float(t.std(unbiased=False)) if len(values) > 1 else 0.0
     return summary
+
+
+def best_eval_key(record: dict[str, Any], selection_metric: str | None) -> tuple[float, float]:
+    """How an evaluation ranks for ``best.pt``: (the mean of the task's ``selection_metric``, the
+    mean return), compared in that order; the return alone (twice) for a task without one. Baoding
+    selects by round rotations, so a policy that swings the balls out and back (paid by the return
+    as a rotation would be) never displaces one that carries them round."""
+    ret = float(record["return_mean"])
+    return (float(record[f"{selection_metric}_mean"]) if selection_metric else ret, ret)
+
+
+def load_best_eval(state: dict[str, Any], selection_metric: str | None) -> tuple[float, float]:
+    """``best_eval_key`` of a checkpoint's best evaluation; for a checkpoint that kept only the best
+    return, that return (the metric unknown: -inf, so the next evaluation takes ``best.pt`` over)."""
+    if "best_eval" in state:
+        metric, ret = state["best_eval"]
+        return float(metric), float(ret)
+    ret = float(state["best_eval_return"])
+    return (-math.inf if selection_metric else ret, ret)
 
 
 class PolicyEvaluator:

@@ -25,7 +25,7 @@ from roto.rl.settings import TrainSettings, read_run_config
 
 CHECKPOINT_DIR = "checkpoints"
 POLICY_KEYS = ("format", "model", "train", "agent", "obs_sizes", "num_actions", "update", "env_steps")
-POLICY_KEYS += ("best_eval_return", "last_eval")
+POLICY_KEYS += ("best_eval_return", "best_eval", "last_eval")
 """What a policy-only checkpoint holds: enough for ``load_policy``, ``roto eval`` and ``roto play``."""
 
 

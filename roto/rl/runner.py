@@ -25,7 +25,7 @@ from roto.rl.build import build_learner, build_model, extra_groups, stacked_size
 from roto.rl.checkpoints import load_checkpoint, save_checkpoint
 from roto.rl.config import AgentConfig, to_dict
 from roto.rl.episode_stats import EpisodeStats
-from roto.rl.evaluation import PolicyEvaluator
+from roto.rl.evaluation import PolicyEvaluator, best_eval_key, load_best_eval
 from roto.rl.logger import ScalarLogger
 from roto.rl.run_dir import CHECKPOINT_DIR, RunDir, checkpoint_path, first_missing, numbered_checkpoints
 from roto.rl.run_lock import hold_run_lock
@@ -102,7 +102,8 @@ class Trainer:
         self.episodes = EpisodeStats(self.env.task.metric_names, self.device)
         self.update = 0
         self.env_steps = 0
-        self.best_eval_return = -math.inf
+        self.best_eval = (-math.inf, -math.inf)
+        """(selection metric, return) of the evaluation ``best.pt`` holds (``best_eval_key``)."""
         self.train_seconds = 0.0  # rollouts + updates so far, summed over resumes (not evaluation or I/O)
         self.last_eval: dict[str, float] = {}
         self.obs: dict[str, torch.Tensor] | None = None
@@ -217,8 +218,9 @@ class Trainer:
         )
         summary = {key: value for key, value in record.items() if key.endswith(("_mean", "_std"))}
         self.last_eval = {f"eval/{key}": value for key, value in summary.items()}
-        if record["return_mean"] > self.best_eval_return:
-            self.best_eval_return = record["return_mean"]
+        key = best_eval_key(record, self.env.task.selection_metric)
+        if key > self.best_eval:
+            self.best_eval = key
             self.save(checkpoint_path(self.run_dir, "best"), policy_only=True)
         return {**self.last_eval, "perf/eval_s": record["eval_s"]}
 
@@ -237,6 +239,9 @@ class Trainer:
         postfix = {"steps/s": f"{scalars['perf/steps_per_s']:.0f}"}
         if self.last_eval:
             postfix["eval return"] = f"{self.last_eval['eval/return_mean']:.1f}"
+            selection = self.env.task.selection_metric
+            for m in (selection,) if selection else ():
+                postfix[f"eval {m}"] = f"{self.last_eval[f'eval/{m}_mean']:.2f}"
             for m in self.env.task.metric_names:
                 postfix[f"eval {m}"] = f"{self.last_eval[f'eval/{m}_mean']:.2f}"
         return postfix
@@ -266,7 +271,8 @@ class Trainer:
             "num_actions": self.env.num_actions,
             "update": self.update,
             "env_steps": self.env_steps,
-            "best_eval_return": self.best_eval_return,
+            "best_eval_return": self.best_eval[1],
+            "best_eval": list(self.best_eval),
             "last_eval": self.last_eval,
         }
 
@@ -294,7 +300,7 @@ class Trainer:
         self.env.load_state_dict(state["env"])
         self.obs = state["obs"]
         self.update, self.env_steps = int(state["update"]), int(state["env_steps"])
-        self.best_eval_return = float(state["best_eval_return"])
+        self.best_eval = load_best_eval(state, self.env.task.selection_metric)
         self.train_seconds = float(state["train_seconds"])
         self.last_eval = dict(state["last_eval"])
         self.evaluator.drop_after(self.update)

@@ -13,7 +13,7 @@ import torch
 from roto.robots import pair_references
 from roto.robots.spec import RobotSpec
 from roto.sim.scene import BallSpec, build_scene
-from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where, zero_on_host
+from roto.tasks.arrays import Array, as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where, zero_on_host
 from roto.tasks.base import (
     PALM_DROP_LIMIT,
     Marker,
@@ -24,7 +24,7 @@ from roto.tasks.base import (
     uniform,
 )
 from roto.tasks.pair_turns import pair_turns
-from roto.tasks.round_swaps import paid_swaps, pair_turn_step
+from roto.tasks.round_swaps import paid_swaps, pair_turn_step, turn_shaping
 
 BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
@@ -115,6 +115,9 @@ class BaodingState:
     turned: torch.Tensor  # (B,) float64: the line's signed turns since the last paid swap
     direction: torch.Tensor  # (B,) float64: +1 or -1, the way round of the first paid swap; 0 before it
     min_turn: torch.Tensor  # () float64: turns a paid swap must follow (0: every swap is paid)
+    # the turn-shaping training aid (roto.tasks.round_swaps.turn_shaping); turn_reward 0 (the benchmark) pays nothing
+    net_turn: torch.Tensor  # (B,) float64: the line's signed turns this episode
+    turn_reward: torch.Tensor  # () float64: reward per turn the pair's net turning grows by
 
 
 def baoding_rule(
@@ -145,6 +148,17 @@ def baoding_rule(
     return dist, swap, swapped, latched
 
 
+def follow_turns(state: BaodingState, pos: Array, swap: Array) -> dict[str, Array]:
+    """The training aids' part of a step: the ball line's turns (``state`` updated), the swaps they
+    pay ("swap" (B,) bool: every swap while ``min_turn`` is 0) and the turn-shaping reward ("turn"
+    (B,): 0 while ``turn_reward`` is 0). ``pos`` (B, 2, 3) ball centres, ``swap`` (B,) bool."""
+    state.pair_angle, turn = pair_turn_step(pos, state.pair_angle, state.angle_set)
+    state.angle_set = state.angle_set | True
+    paid, state.turned, state.direction = paid_swaps(swap, state.turned + turn, state.direction, state.min_turn)
+    shaped, state.net_turn = turn_shaping(state.net_turn, turn, state.turn_reward)
+    return {"swap": paid, "turn": shaped}
+
+
 class Baoding:
     """The Baoding task (robot-agnostic; targets and ball size come from the robot record)."""
 
@@ -155,10 +169,11 @@ class Baoding:
     on targets where they rest, partly inside the hand."""
     metric_names = ("swaps", "rotations")
     headline_metric = "rotations"
-    parameters = MappingProxyType({"success_radius": SUCCESS_RADIUS, "swap_min_turn": 0.0})
+    parameters = MappingProxyType({"success_radius": SUCCESS_RADIUS, "swap_min_turn": 0.0, "turn_reward": 0.0})
     """What training aids may change: the latch radius (m; a tolerance curriculum starts it wider,
-    ``roto.envs.aids.tolerance``) and the turns a paid swap must follow (0: every swap is paid; the
-    round-swaps aid sets it, ``roto.tasks.round_swaps``)."""
+    ``roto.envs.aids.tolerance``), the turns a paid swap must follow (0: every swap is paid; the
+    round-swaps aid sets it, ``roto.tasks.round_swaps``) and the reward per turn of the pair's net
+    turning (0: none; the turn-shaping aid sets it, ``roto.tasks.round_swaps.turn_shaping``)."""
     reference_name = "reference controller"
 
     @property
@@ -168,6 +183,8 @@ class Baoding:
         return pair_references(self.name)
 
     observation_size = 8
+    selection_metric = "round_rotations"
+    """``best.pt`` goes by round rotations (a swing out and back scores about 0.25), then the return."""
     path_metric_names = ("net_turns", "travelled_turns", "round_rotations")
     """Whether the balls went round each other or swung out and back (``roto.tasks.pair_turns``): a
     swap counts either way; ``round_rotations`` counts only the rotations the pair's net turning
@@ -194,16 +211,20 @@ class Baoding:
             turned=torch.zeros(num_envs, dtype=torch.float64, device=device),
             direction=torch.zeros(num_envs, dtype=torch.float64, device=device),
             min_turn=torch.zeros((), dtype=torch.float64, device=device),
+            net_turn=torch.zeros(num_envs, dtype=torch.float64, device=device),
+            turn_reward=torch.zeros((), dtype=torch.float64, device=device),
         )
 
     def set_parameter(self, state: BaodingState, name: str, value: float | torch.Tensor) -> None:
-        """Set ``success_radius`` or ``swap_min_turn`` of every world (``Task.set_parameter``)."""
-        set_state_parameter(state, {"success_radius": "radius", "swap_min_turn": "min_turn"}, name, value)
+        """Set ``success_radius``, ``swap_min_turn`` or ``turn_reward`` of every world (``Task.set_parameter``)."""
+        fields = {"success_radius": "radius", "swap_min_turn": "min_turn", "turn_reward": "turn_reward"}
+        set_state_parameter(state, fields, name, value)
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:
         """Clear the latches, swap count and assignment (ball a -> T_a, ball b -> T_b), and the ball
         line's turns, of the worlds in ``mask`` (B,) bool."""
-        for latch in (state.swapped, state.latched, state.swaps, state.angle_set, state.turned, state.direction):
+        turns = (state.angle_set, state.turned, state.direction, state.net_turn)
+        for latch in (state.swapped, state.latched, state.swaps, *turns):
             clear_where(latch, mask)
 
     def initial_ball_positions(self, state: BaodingState, n: int, generator: torch.Generator) -> torch.Tensor:
@@ -214,25 +235,19 @@ class Baoding:
 
     def step(self, state: BaodingState, inputs: TaskInputs) -> StepResult:
         """Latch, swap (+10; with the round-swaps aid, only a swap that followed a turn), dense
-        shaping; end when the balls part or drop."""
+        shaping (with the turn-shaping aid, a "turn" term too); end when the balls part or drop."""
         pos = inputs.ball_pos
         dist, swap, state.swapped, state.latched = baoding_rule(
             pos, state.targets, state.swapped, state.latched, state.radius
         )
         state.swaps += swap
-        if zero_on_host(state.min_turn):  # the benchmark: every swap is paid (the aid's state stays idle)
-            paid = swap
-        else:
-            state.pair_angle, turn = pair_turn_step(pos, state.pair_angle, state.angle_set)
-            state.angle_set = state.angle_set | True
-            paid, state.turned, state.direction = paid_swaps(swap, state.turned + turn, state.direction, state.min_turn)
-        dense = DENSE_SCALE * (1.0 - tanh(dist / DENSE_LENGTH)).sum(axis=1)
+        terms = {"swap": swap, "distance": DENSE_SCALE * (1.0 - tanh(dist / DENSE_LENGTH)).sum(axis=1)}
+        if not (zero_on_host(state.min_turn) and zero_on_host(state.turn_reward)):  # an aid follows the turns
+            terms.update(follow_turns(state, pos, swap))
+        terms["swap"] = SWAP_REWARD * as_dtype_of(terms["swap"], pos)
         parted = squared_norm(pos[:, 0] - pos[:, 1]) >= MAX_SEPARATION**2
         dropped = (pos[:, :, 2] < -PALM_DROP_LIMIT).any(axis=1)
-        terminated = parted | dropped
-        return StepResult(
-            reward_terms={"swap": SWAP_REWARD * as_dtype_of(paid, pos), "distance": dense}, terminated=terminated
-        )
+        return StepResult(reward_terms=terms, terminated=parted | dropped)
 
     def metrics(self, state: BaodingState) -> dict[str, torch.Tensor]:
         """Swaps and rotations (= swaps / 2) so far this episode."""

@@ -82,6 +82,9 @@ class Task(Protocol):
     is set beside."""
     observation_size: int
     """Features per world of ``observation`` (the ``task`` observation group holds one more: time left)."""
+    selection_metric: str | None
+    """The evaluation measure ``best.pt`` is chosen by and reports lead with (one of
+    ``metric_names`` or ``path_metric_names``), the return breaking ties; None: the return alone."""
     path_metric_names: tuple[str, ...]
     """Episode measures read from the balls' whole path and the episode's metrics (``path_metrics``);
     evaluation reports them, training never sees them. May be empty."""

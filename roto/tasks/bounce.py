@@ -85,6 +85,8 @@ class Bounce:
         return pair_references(self.name)
 
     observation_size = 3
+    selection_metric = None
+    """``best.pt`` goes by the return, as roto's does."""
     path_metric_names = ()
     parameters = MappingProxyType({})
     """Bounce has no parameter a training aid may change."""

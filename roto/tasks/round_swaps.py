@@ -1,13 +1,16 @@
-"""A training-only aid for Baoding: pay a swap only where the balls went round each other.
+"""Training-only aids for Baoding that follow the line between the balls: pay a swap only where the
+balls went round each other (``paid_swaps``), and pay the pair's net turning (``turn_shaping``).
 
 roto's swap counts whichever way the balls traded places (``roto.tasks.pair_turns``), so a policy
-may swing the pair out along an arc and back and score every swing. With this aid a training
-env pays a swap's reward only when the line from ball a to ball b has turned, since the last swap
+may swing the pair out along an arc and back and score every swing. With the round-swaps aid a
+training env pays a swap's reward only when the line from ball a to ball b has turned, since the last swap
 it paid, at least ``min_turn`` turns the same way round as the episode's first paid swap. A pair
 carried round one way turns half a turn per swap and is paid for every swap; a pair swung out and
 back is paid once an episode. The swap still happens and counts (the latches, the targets and the
 swap metric are roto's); only the reward changes, and only where an env config asks for it
-(``EnvConfig.swap_min_turn``, a training aid evaluation never uses).
+(``EnvConfig.swap_min_turn``, a training aid evaluation never uses). With the turn-shaping aid
+(``EnvConfig.turn_reward``) a training env also earns a reward for each turn the pair's net
+turning this episode grows, and gives it back as the turning shrinks.
 
 The line is measured in the task frame's x-y plane (the palm's), where the balls roll.
 """
@@ -52,3 +55,24 @@ def paid_swaps(swap: Array, turned: Array, direction: Array, min_turn: float | A
     way = where(direction == 0, where(turned >= 0, 1.0, -1.0), direction)
     paid = swap & ((min_turn <= 0) | (turned * way >= min_turn))
     return paid, where(paid, 0.0, turned), where(paid, way, direction)
+
+
+def turn_shaping(net_turn: Array, turn: Array, turn_reward: float | Array) -> tuple[Array, Array]:
+    """The turn-shaping reward: ``turn_reward`` per turn the magnitude of the pair's net turning
+    this episode grows (pure; torch or numpy).
+
+    A potential-based shaping term with potential ``turn_reward * |net turns|``: over an episode it
+    sums to ``turn_reward * |net turns at the end|``, so a pair carried round one way earns it for
+    every turn and a swing out and back earns nothing (it pays on the way out what it takes back on
+    the way back). Either way round counts.
+
+    Args:
+        net_turn: (B,) signed turns of the ball line so far this episode.
+        turn: (B,) signed turns this step (``pair_turn_step``).
+        turn_reward: reward per turn (0: the benchmark, nothing paid).
+
+    Returns:
+        (reward (B,), new net_turn (B,))
+    """
+    net = net_turn + turn
+    return turn_reward * (abs(net) - abs(net_turn)), net

@@ -21,6 +21,7 @@ class _ToyTask:
     metric_names: tuple[str, ...] = ("hits",)
     headline_metric: str = "hits"
     path_metric_names: tuple[str, ...] = ()
+    selection_metric: str | None = None
 
 
 class ToyEnv:

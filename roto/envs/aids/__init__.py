@@ -9,6 +9,7 @@ from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
 from roto.envs.aids.replayed_starts import ReplayedStarts
 from roto.envs.aids.round_swaps import RoundSwaps
 from roto.envs.aids.tolerance import ToleranceAid
+from roto.envs.aids.turn_shaping import TurnShaping
 
 __all__ = [
     "AidHost",
@@ -18,6 +19,7 @@ __all__ = [
     "StepContext",
     "ToleranceAid",
     "TrainingAid",
+    "TurnShaping",
     "build_aids",
 ]
 
@@ -25,7 +27,8 @@ __all__ = [
 def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
     """The aids ``host.config`` asks for (none for an evaluation env): replayed starts (a bank in
     ``replay_starts``), recorded own events (``replay_record_lead`` > 0, drawn by the replayed
-    starts), the tolerance curriculum (``tolerance_start`` > 0), round swaps (``swap_min_turn`` > 0)."""
+    starts), the tolerance curriculum (``tolerance_start`` > 0), round swaps (``swap_min_turn`` > 0),
+    turn shaping (``turn_reward`` > 0)."""
     config, aids = host.config, []
     replay = ReplayedStarts(host) if config.replay_starts is not None else None
     if replay is not None:
@@ -36,4 +39,6 @@ def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
         aids.append(ToleranceAid(host))
     if config.swap_min_turn > 0.0:
         aids.append(RoundSwaps(host))
+    if config.turn_reward > 0.0:
+        aids.append(TurnShaping(host))
     return tuple(aids)

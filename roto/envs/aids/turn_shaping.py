@@ -1,0 +1,15 @@
+"""The turn-shaping aid: a training env earns ``EnvConfig.turn_reward`` per turn the pair's net
+turning this episode grows, and gives it back as it shrinks (``roto.tasks.round_swaps.turn_shaping``),
+so carrying the balls round pays and swinging them out and back does not. It only sets the task's
+``turn_reward`` parameter; the task does the rest (a "turn" reward term)."""
+
+from __future__ import annotations
+
+from roto.envs.aids.protocol import AidHost, TrainingAid
+
+
+class TurnShaping(TrainingAid):
+    """Sets the task parameter ``turn_reward`` once, when the env is built."""
+
+    def __init__(self, host: AidHost) -> None:
+        host.task.set_parameter(host.task_state, "turn_reward", host.config.turn_reward)

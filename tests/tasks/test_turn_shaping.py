@@ -1,0 +1,80 @@
+"""The turn-shaping training aid: a reward per turn the pair's net turning grows, given back as it
+shrinks; a pair carried round earns it for every turn, a swing out and back earns nothing, either
+way round counts, and with the aid off nothing is paid and the reward terms are the benchmark's."""
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+import roto
+from roto.envs.config import EnvConfig
+from roto.rl.settings import TrainSettings
+from roto.tasks.baoding import Baoding
+from roto.tasks.base import TaskInputs
+from roto.tasks.round_swaps import turn_shaping
+from tests.tasks.test_round_swaps import SHADOW, path_round_the_targets
+
+
+def test_the_shaping_pays_growth_of_the_net_turning_and_takes_it_back_as_it_shrinks():
+    net = torch.tensor([0.0, 0.2, -0.2, 0.1], dtype=torch.float64)
+    turn = torch.tensor([0.1, 0.1, -0.1, -0.3], dtype=torch.float64)
+    reward, new_net = turn_shaping(net, turn, 20.0)
+    assert new_net.tolist() == pytest.approx([0.1, 0.3, -0.3, -0.2])
+    assert reward.tolist() == pytest.approx([2.0, 2.0, 2.0, 2.0])  # |0.1| - |-0.2|... each grows by 0.1
+    reward, _ = turn_shaping(torch.tensor([0.3]), torch.tensor([-0.1]), 20.0)
+    assert float(reward[0]) == pytest.approx(-2.0)
+
+
+def shaped_rewards(path, turn_reward):
+    """(sum of the "turn" term over ``path``, the terms' names) of one Baoding world."""
+    task = Baoding()
+    state = task.init_state(SHADOW, 1, torch.device("cpu"))
+    task.set_parameter(state, "turn_reward", turn_reward)
+    total, names = 0.0, set()
+    for pos in path:
+        inputs = TaskInputs(
+            ball_pos=pos[None],
+            ball_vel=torch.zeros(1, 2, 3, dtype=torch.float64),
+            ball_contact=torch.ones(1, 2, dtype=torch.bool),
+        )
+        terms = task.step(state, inputs).reward_terms
+        names |= set(terms)
+        total += float(terms.get("turn", torch.zeros(1))[0])
+    return total, names
+
+
+def test_a_pair_carried_round_earns_per_turn_either_way_and_a_swing_earns_nothing():
+    round_path = path_round_the_targets(np.linspace(0.5 * math.pi, 4.5 * math.pi, 121))  # two turns
+    total, names = shaped_rewards(round_path, 20.0)
+    assert total == pytest.approx(40.0) and names == {"swap", "distance", "turn"}
+    total, _ = shaped_rewards(path_round_the_targets(np.linspace(4.5 * math.pi, 0.5 * math.pi, 121)), 20.0)
+    assert total == pytest.approx(40.0)
+    out, back = np.linspace(0.5 * math.pi, 2.0 * math.pi, 46), np.linspace(2.0 * math.pi, 0.5 * math.pi, 46)[1:]
+    total, _ = shaped_rewards(path_round_the_targets(np.concatenate([out, back, out[1:], back])), 20.0)
+    assert total == pytest.approx(0.0, abs=1e-9)
+    total, names = shaped_rewards(round_path, 0.0)  # the benchmark: no turn term at all
+    assert total == 0.0 and names == {"swap", "distance"}
+
+
+def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
+    env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, turn_reward=20.0)
+    assert float(env.task_state.turn_reward) == 20.0 and [type(a).__name__ for a in env.aids] == ["TurnShaping"]
+    assert float(roto.make("baoding", robot="shadow", num_envs=2, seed=0).task_state.turn_reward) == 0.0
+    settings = TrainSettings(env=EnvConfig(task="baoding", turn_reward=20.0))
+    assert settings.eval_env_config(4).turn_reward == 0.0 and settings.env_config().turn_reward == 20.0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "pattern"),
+    [
+        ({"task": "bounce", "turn_reward": 20.0}, r"turn_reward applies to a task with a ball pair.*'bounce'"),
+        ({"task": "baoding", "turn_reward": -1.0}, r"turn_reward must be a reward per turn in \[0, 1000\].*-1.0"),
+        ({"task": "baoding", "turn_reward": float("nan")}, r"got nan"),
+        ({"task": "baoding", "turn_reward": "20"}, r"got '20'"),
+    ],
+)
+def test_bad_turn_reward_is_refused(kwargs, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        EnvConfig(**kwargs)
