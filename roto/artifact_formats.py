@@ -9,8 +9,10 @@ from __future__ import annotations
 from types import MappingProxyType
 
 FORMAT_KEY = "format"
-FORMATS = MappingProxyType({"checkpoint": 1, "run config": 1, "cell summary": 1, "bank": 1})
-"""{kind of file: the format this roto writes (and the newest it reads)}."""
+FORMATS = MappingProxyType({"checkpoint": 2, "run config": 2, "cell summary": 1, "bank": 1})
+"""{kind of file: the format this roto writes (and the newest it reads)}. Checkpoints and run
+configs 2: the env's training aids in one ``aids`` section (format 1 held them as flat env fields;
+``roto.envs.aids.settings.aids_from_legacy_fields`` reads them)."""
 
 
 def format_stamp(kind: str) -> dict[str, int]:

@@ -28,13 +28,16 @@ def make(
     """
     import dataclasses
 
+    from roto.envs.aids.settings import LEGACY_FIELDS
     from roto.envs.config import EnvConfig
     from roto.envs.roto_env import RotoEnv
 
     valid = sorted(f.name for f in dataclasses.fields(EnvConfig) if f.name not in ("task", "robot"))
     unknown = sorted(set(options) - set(valid))
     if unknown:
-        raise ValueError(f"unknown env option(s) {unknown}; valid options: {valid}")
+        moved = {name: "aids=" + repr({LEGACY_FIELDS[name][0]: {LEGACY_FIELDS[name][1]: "..."}}) for name in unknown}
+        hint = [f"{name} is now {new}" for name, new in moved.items() if name in LEGACY_FIELDS]
+        raise ValueError(f"unknown env option(s) {unknown}; valid options: {valid}" + "".join(f"; {h}" for h in hint))
     config = EnvConfig(
         task=get_task(task).name,
         robot=get_robot(robot).name,

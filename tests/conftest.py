@@ -15,12 +15,12 @@ SHADOW_BANK = str(
 """The Shadow reference controller's pre-swap states (a packaged recipe's replay bank)."""
 
 BAODING_AIDS = {
-    "replay_starts": SHADOW_BANK,
-    "replay_share": 0.5,
-    "replay_record_lead": 10,
-    "tolerance_start": 0.025,
-    "tolerance_target": 2.0,
-    "swap_min_turn": 0.25,
+    "aids": {
+        "replayed_starts": {"bank": SHADOW_BANK, "share": 0.5, "record_lead": 10},
+        "tolerance": {"start": 0.025, "target": 2.0},
+        "round_swaps": {"min_turn": 0.25},
+        "turn_shaping": {"per_turn": 20.0},
+    }
 }
 """Every training aid of the Baoding recipes at once (baoding_cpu_shadow, baoding_cpu_orca_round)."""
 

@@ -43,7 +43,7 @@ def newer_summary(path):
 def newer_bank(path):
     with np.load(SHADOW_BANK) as saved:
         np.savez(path / "bank.npz", **{name: saved[name] for name in saved.files}, format=np.array(99))
-    return lambda: roto.make("baoding", replay_starts=str(path / "bank.npz"), replay_share=0.5)
+    return lambda: roto.make("baoding", aids={"replayed_starts": {"bank": str(path / "bank.npz"), "share": 0.5}})
 
 
 NEWER = {"checkpoint": newer_checkpoint, "run config": newer_run_config, "cell summary": newer_summary}
@@ -57,7 +57,7 @@ def test_a_newer_format_is_refused_naming_the_file(kind, newer, tmp_path):
     with pytest.raises(ValueError) as refused:
         read()
     message = str(refused.value)
-    assert f"of format 99; this roto reads {kind} formats 1 to 1" in message and str(tmp_path) in message
+    assert f"of format 99; this roto reads {kind} formats 1 to {FORMATS[kind]}" in message and str(tmp_path) in message
     assert "\n" not in message
 
 
@@ -67,3 +67,18 @@ def test_a_file_without_a_format_predates_them_and_reads_as_before(tmp_path):
     assert "format" not in load_checkpoint(tmp_path / "old.pt")
     with pytest.raises(ValueError, match="format True"):
         check_format("bank", True, "b.npz")
+
+
+SHADOW_BANK_IN_REPO = "benchmarks/results/baoding_reference/shadow_preswap.npz"
+
+
+def test_a_format_1_run_config_with_flat_aid_fields_reads_into_the_aids_section(tmp_path):
+    config = yaml.safe_load((pathlib.Path(__file__).parent / "data" / "run_config_format1.yaml").read_text())
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
+    settings, _ = read_run_config(tmp_path)
+    aids = settings.env.aids
+    replayed = aids.replayed_starts
+    assert (replayed.bank, replayed.share, replayed.record_lead) == (SHADOW_BANK_IN_REPO, 0.5, 10)
+    assert (aids.tolerance.start, aids.tolerance.target) == (0.025, 2) and aids.round_swaps is None  # 0.0: off
+    assert aids.turn_shaping.per_turn == 20 and settings.to_dict()["env"]["aids"] == aids.to_dict()
+    assert TrainSettings.from_dict(settings.to_dict()) == settings

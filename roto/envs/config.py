@@ -4,23 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.util
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
+from roto.envs.aids.settings import AidsConfig, parse_aids
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, TOUCH_MODES
 from roto.sim.backend import BACKENDS
-
-TRAINING_AID_FIELDS = (
-    "replay_starts",
-    "replay_share",
-    "replay_record_lead",
-    "replay_record_capacity",
-    "tolerance_start",
-    "tolerance_target",
-    "swap_min_turn",
-    "turn_reward",
-)
-"""The env fields that are training aids: a run's training envs may set them; evaluation and the
-benchmark never do (``EnvConfig.without_training_aids``)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -52,29 +40,10 @@ class EnvConfig:
         nconmax: contacts per world the ``warp`` backend allocates (None: roto's measured figure for
             this robot and task, ``roto.envs.capacity``).
         njmax: constraint rows per world for ``warp`` (None: as for ``nconmax``).
-        replay_starts: a training aid: an ``.npz`` of recorded states (``roto demo --task baoding
-            --preswap_out``: states just before swaps) that episodes may start from.
-        replay_share: the share of episode starts drawn from ``replay_starts`` instead of the
-            task's own starts (0: none). Training only: evaluation envs always start from the
-            task's own starts (``without_training_aids``).
-        replay_record_lead: a training aid beside ``replay_starts`` (0: off): the training envs'
-            own states this many control steps before each rise of the task's headline metric
-            (a Baoding swap) join the bank they replay from (``roto.envs.aids.event_recorder``).
-        replay_record_capacity: the most states so recorded (the oldest replaced first).
-        tolerance_start: a training aid for a task with a success radius (Baoding; 0: off): the
-            radius starts this wide (m) and narrows to the task's own as the training episodes'
-            headline metric rises (``roto.envs.aids.tolerance``).
-        tolerance_target: the headline metric per training episode (Baoding: rotations) at which
-            the radius is the task's own.
-        swap_min_turn: a training aid for Baoding (0: off): a swap earns its reward only when the
-            line from one ball to the other has turned at least this many turns since the last
-            paid swap, the same way round as the episode's first (0.25: a quarter turn; a pair
-            carried round turns half a turn a swap, one swung out and back is paid once an
-            episode). Swaps still count as roto counts them (``roto.tasks.round_swaps``).
-        turn_reward: a training aid for Baoding (0: off): reward per turn the magnitude of the
-            pair's net turning this episode grows (given back as it shrinks: a potential-based
-            shaping term, "turn"), so a pair carried round earns it and a swing out and back does
-            not (``roto.tasks.round_swaps.turn_shaping``).
+        aids: the training aids of the training envs (``roto.envs.aids.settings``: replayed
+            starts, a tolerance curriculum, round swaps, turn shaping; none by default). A plain
+            mapping ({aid: {setting: value}}, as YAML holds it) is read into ``AidsConfig``.
+            Evaluation envs carry none (``without_training_aids``).
     """
 
     task: str
@@ -95,14 +64,7 @@ class EnvConfig:
     reset_joint_noise: float = 0.2
     nconmax: int | None = None
     njmax: int | None = None
-    replay_starts: str | None = None
-    replay_share: float = 0.0
-    replay_record_lead: int = 0
-    replay_record_capacity: int = 1024
-    tolerance_start: float = 0.0
-    tolerance_target: float = 1.0
-    swap_min_turn: float = 0.0
-    turn_reward: float = 0.0
+    aids: AidsConfig = field(default_factory=AidsConfig)
 
     def __post_init__(self) -> None:
         """Reject impossible values with a message naming the value and the valid choices."""
@@ -135,65 +97,13 @@ class EnvConfig:
             value = getattr(self, name)
             if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
                 raise ValueError(f"{name} must be an integer >= 1 or None, got {value!r}")
-        self._check_replay()
-        self._check_tolerance()
-        self._check_turn_aids()
+        object.__setattr__(self, "aids", parse_aids(self.aids))  # a mapping read back from YAML
+        self.aids.check(get_task(self.task))
         self._check_device()
 
     def without_training_aids(self) -> EnvConfig:
         """This config as the benchmark defines the task: every training aid at its default (off)."""
-        defaults = {f.name: f.default for f in dataclasses.fields(EnvConfig) if f.name in TRAINING_AID_FIELDS}
-        return dataclasses.replace(self, **defaults)
-
-    def _check_replay(self) -> None:
-        share = self.replay_share
-        if isinstance(share, bool) or not isinstance(share, (int, float)) or not 0.0 <= share <= 1.0:
-            raise ValueError(f"replay_share must be a number in [0, 1], got {share!r}")
-        if share > 0.0 and self.replay_starts is None:
-            raise ValueError(f"replay_share {share} needs replay_starts (an .npz of recorded states); got none")
-        for name, low in (("replay_record_lead", 0), ("replay_record_capacity", 1)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-        if self.replay_record_lead > 0 and share == 0.0:
-            raise ValueError(
-                f"replay_record_lead {self.replay_record_lead} records states for replayed starts, but replay_share "
-                "is 0 (nothing would replay them); set replay_share and replay_starts"
-            )
-
-    def _check_tolerance(self) -> None:
-        from roto.tasks import get_task
-
-        start, target = self.tolerance_start, self.tolerance_target
-        for name, value in (("tolerance_start", start), ("tolerance_target", target)):
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0.0:
-                raise ValueError(f"{name} must be a number >= 0, got {value!r}")
-        if start == 0.0:
-            return
-        own = get_task(self.task).parameters.get("success_radius")
-        if own is None:
-            raise ValueError(
-                f"tolerance_start applies to a task with a success radius (baoding); task {self.task!r} has none"
-            )
-        if start < own or target <= 0.0:
-            raise ValueError(
-                f"tolerance_start must be at least the task's own radius {own} m and tolerance_target > 0, "
-                f"got {start}, {target}"
-            )
-
-    def _check_turn_aids(self) -> None:
-        from roto.tasks import get_task
-
-        value = self.swap_min_turn
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 0.5:
-            raise ValueError(f"swap_min_turn must be a number of turns in [0, 0.5] (0: off), got {value!r}")
-        if value > 0.0 and "swap_min_turn" not in get_task(self.task).parameters:
-            raise ValueError(f"swap_min_turn applies to a task with swaps (baoding); task {self.task!r} has none")
-        value = self.turn_reward
-        if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value <= 1000.0:
-            raise ValueError(f"turn_reward must be a reward per turn in [0, 1000] (0: off), got {value!r}")
-        if value > 0.0 and "turn_reward" not in get_task(self.task).parameters:
-            raise ValueError(f"turn_reward applies to a task with a ball pair (baoding); task {self.task!r} has none")
+        return dataclasses.replace(self, aids=AidsConfig())
 
     def _check_device(self) -> None:
         device = str(self.device)

@@ -3,7 +3,7 @@
 A bank holds states recorded in one hand's scene, e.g. by the Baoding reference controller just
 before its swaps (``roto demo --task baoding --preswap_out``): each state's physics (qpos and qvel),
 the joint targets held then, and the task state fields the file carries (Baoding: ``swapped`` and
-``latched``). The env draws a share of its episode starts from the bank (``EnvConfig.replay_share``)
+``latched``). The env draws a share of its episode starts from the bank (``ReplayedStartsSettings.share``)
 instead of the task's own starts; evaluation never does.
 """
 
@@ -72,7 +72,7 @@ def read_bank(path: str | pathlib.Path) -> dict[str, np.ndarray]:
         ValueError naming the file and what is wrong with it in one line (missing, a directory,
         not an ``.npz``, truncated or corrupted, or holding object arrays), never loading unsafely.
     """
-    where = f"replay_starts {str(path)!r}"
+    where = f"aids.replayed_starts.bank {str(path)!r}"
     if not pathlib.Path(path).is_file():  # checked here, where it is read: a run's config stays loadable without it
         what = "is a directory" if pathlib.Path(path).is_dir() else "is not a file"
         raise ValueError(
@@ -106,7 +106,7 @@ def check_bank(path: str, arrays: dict[str, np.ndarray], task: str, robot: str, 
     Raises:
         ValueError naming the file, what was expected and what was found.
     """
-    where = f"replay_starts {path!r}"
+    where = f"aids.replayed_starts.bank {path!r}"
     found = arrays.get(FORMAT_KEY)
     check_format("bank", None if found is None else found.item(), where)
     for name, own in (("task", task), ("robot", robot)):  # a bank without the entry: its shapes must fit
@@ -162,7 +162,8 @@ def load_replay_bank(
 def check_replay_starts(config: EnvConfig) -> None:
     """Read and check the bank ``config`` names against its hand's scene as its envs will, without
     building them: so a run, a plan or a sweep is refused before it creates anything."""
-    if config.replay_starts is None:
+    replayed = config.aids.replayed_starts
+    if replayed is None:
         return
     from roto.robots import get_robot
     from roto.sim.scene import build_scene
@@ -171,4 +172,4 @@ def check_replay_starts(config: EnvConfig) -> None:
     task, robot = get_task(config.task), get_robot(config.robot)
     model, _ = build_scene(robot, task.balls(robot), config.touch)
     state = task.init_state(robot, 1, torch.device("cpu"))
-    load_replay_bank(config.replay_starts, model, robot.name, task.name, state, robot.num_actions)
+    load_replay_bank(replayed.bank, model, robot.name, task.name, state, robot.num_actions)

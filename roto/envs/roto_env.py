@@ -18,7 +18,8 @@ import numpy as np
 import torch
 
 from roto.envs.action_checks import check_action_finite, check_action_layout
-from roto.envs.aids import AidHost, StepContext, TrainingAid, build_aids
+from roto.envs.aids.build import build_aids
+from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
 from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action

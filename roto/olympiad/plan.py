@@ -13,7 +13,7 @@ A plan is a YAML file::
       force_touch:
         bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004, env.touch=force]}
       replayed:             # {robot} in an override or the agent config becomes each cell's hand
-        baoding: {overrides: ["env.replay_starts=starts/{robot}.npz", env.replay_share=0.25]}
+        baoding: {overrides: ["env.aids.replayed_starts.bank=starts/{robot}.npz", env.aids.replayed_starts.share=0.25]}
       tuned:                # a config per hand (each must exist for every hand the grids name)
         bounce: {agent_cfg: "bounce_cpu_{robot}"}
     grids:                  # the cells: the union of these products

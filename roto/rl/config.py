@@ -3,8 +3,8 @@
 A config file mirrors ``AgentConfig``: sections ``network``, ``ppo``, ``ssl`` and ``run``. An unknown
 key is an error naming its dotted path and the valid keys; a missing key keeps its default. A file
 may start from another with ``extends: NAME`` and list only what it changes. An optional
-``training_aids`` section sets training-only env settings (``TRAINING_AID_FIELDS``: replayed
-starts, the tolerance curriculum) that the run's training envs use and evaluation never does.
+``training_aids`` section switches on training aids (the env's ``aids`` section,
+``roto.envs.aids.settings``) that the run's training envs use and evaluation never does.
 ``key=value`` overrides (e.g. ``ppo.lr=1e-4``, ``ssl.forward_dynamics.weight=0.01``) are applied on
 top, with the value parsed as YAML.
 """
@@ -22,7 +22,7 @@ from typing import Any
 
 import yaml
 
-from roto.envs.config import TRAINING_AID_FIELDS
+from roto.envs.aids.settings import LEGACY_FIELDS
 from roto.rl.ssl.configs import SSLConfig, check_groups
 from roto.yaml_files import read_yaml
 
@@ -289,7 +289,7 @@ def resolve_config_path(task: str, path: str | pathlib.Path | None) -> pathlib.P
 EXTENDS = "extends"
 """Top-level key of an agent config naming the config it changes (a packaged name or a file)."""
 TRAINING_AIDS = "training_aids"
-"""Top-level section of an agent config with training-only env settings (``TRAINING_AID_FIELDS``)."""
+"""Top-level section of an agent config with the training envs' aids (the env's ``aids`` section)."""
 
 
 def merge(base: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
@@ -345,19 +345,27 @@ def load_agent_config(
 
 
 def load_training_aids(task: str, path: str | pathlib.Path | None, robot: str) -> dict[str, Any]:
-    """{env field: value} of the config's ``training_aids`` section ({} without one), ``{robot}``
-    in a text value replaced by ``robot`` (e.g. a per-hand bank of recorded starts). A key that is
-    not a training aid is a ValueError naming the valid ones."""
+    """The config's ``training_aids`` section ({} without one): the env's ``aids`` section
+    ({aid: {setting: value}}, ``roto.envs.aids.settings``) with ``{robot}`` in a text value
+    replaced by ``robot`` (e.g. a per-hand bank of recorded starts). Its aids and settings are
+    checked when the env config is built."""
     config_path = resolve_config_path(task, path)
     data = read_agent_data(config_path)
     aids = (data.get(TRAINING_AIDS) if isinstance(data, dict) else None) or {}
     where = f"agent config {str(config_path)!r}: {TRAINING_AIDS}"
     if not isinstance(aids, dict):
-        raise ValueError(f"{where} must be a mapping of env fields to values, got {aids!r}")
-    if set(aids) - set(TRAINING_AID_FIELDS):
-        unknown = sorted(set(aids) - set(TRAINING_AID_FIELDS))
-        raise ValueError(f"{where} {unknown!r} are not training aids; valid keys: {list(TRAINING_AID_FIELDS)}")
-    return {key: value.replace("{robot}", robot) if isinstance(value, str) else value for key, value in aids.items()}
+        raise ValueError(f"{where} must be a mapping of aids to their settings, got {aids!r}")
+    flat = sorted(set(aids) & set(LEGACY_FIELDS))
+    if flat:
+        spelled = [".".join(LEGACY_FIELDS[name]) for name in flat]
+        raise ValueError(f"{where}: {flat} are now set per aid, as {spelled} (roto.envs.aids.settings)")
+
+    def for_robot(value: Any) -> Any:
+        if isinstance(value, dict):
+            return {key: for_robot(item) for key, item in value.items()}
+        return value.replace("{robot}", robot) if isinstance(value, str) else value
+
+    return for_robot(aids)
 
 
 __all__ = [

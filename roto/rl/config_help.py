@@ -106,8 +106,9 @@ def help_config() -> str:
     lines += block(config_keys(AgentConfig))
     lines += [
         "",
-        "Env keys (env.key=value overrides; task, robot and obs mode are the run's own flags; the training aids"
-        " among them may also be set in an agent config's training_aids section, {robot} standing for the hand):",
+        "Env keys (env.key=value overrides; task, robot and obs mode are the run's own flags; the training aids,"
+        " env.aids.<aid>.<setting>, may also be set in an agent config's training_aids section as"
+        " <aid>: {<setting>: value}, {robot} standing for the hand):",
     ]
     lines += block(config_keys(EnvConfig, "env.", skip=FIXED_ENV_KEYS))
     return "\n".join(lines)

@@ -1,8 +1,10 @@
 """One override syntax for a run's envs and its agent: ``section.key=value``.
 
-``env.<field>=value`` changes the training envs' config (``EnvConfig``, e.g. ``env.num_envs=64``);
-every other section is the agent config's (``network``, ``ppo``, ``ssl``, ``run``, e.g.
-``ppo.lr=1e-4``). Values are parsed as YAML. ``roto train`` and ``roto sweep`` read both kinds.
+``env.<field>=value`` changes the training envs' config (``EnvConfig``, e.g. ``env.num_envs=64``),
+``env.aids.<aid>.<setting>=value`` one setting of a training aid (switching the aid on;
+``env.aids.<aid>=null`` switches it off; ``roto.envs.aids.settings``); every other section is
+the agent config's (``network``, ``ppo``, ``ssl``, ``run``, e.g. ``ppo.lr=1e-4``). Values are
+parsed as YAML. ``roto train`` and ``roto sweep`` read both kinds.
 """
 
 from __future__ import annotations
@@ -10,8 +12,11 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from roto.envs.aids.settings import LEGACY_FIELDS
 from roto.envs.config import EnvConfig
-from roto.rl.config import parse_override
+from roto.rl.config import merge, parse_override
+
+AIDS = "aids"
 
 ENV_SECTION = "env"
 FIXED_ENV_KEYS = ("task", "robot", "obs_mode", "extra_groups")
@@ -34,12 +39,31 @@ def split_overrides(items: list[str]) -> tuple[dict[str, Any], list[str]]:
         if section != ENV_SECTION:
             agent.append(item)
             continue
-        if leaf not in env_override_keys():
+        if leaf in LEGACY_FIELDS:
+            new = "env.aids." + ".".join(LEGACY_FIELDS[leaf])
+            raise ValueError(f"override {item!r}: training aids are set per aid now: {new}=...")
+        name, _, rest = leaf.partition(".")
+        if name not in env_override_keys() or (rest and name != AIDS):
             raise ValueError(f"override {item!r}: unknown env key {leaf!r}; valid env keys: {env_override_keys()}")
-        env[leaf] = value
+        if rest:  # env.aids.<aid>[.<setting>]
+            set_nested(env.setdefault(AIDS, {}), rest.split("."), value)
+        else:
+            env[name] = merge(env[name], value) if name == AIDS and isinstance(env.get(name), dict) else value
     return env, agent
 
 
+def set_nested(section: dict[str, Any], keys: list[str], value: Any) -> None:
+    """``section[k1][k2]... = value``, making the mappings on the way."""
+    for key in keys[:-1]:
+        if not isinstance(section.get(key), dict):
+            section[key] = {}
+        section = section[key]
+    section[keys[-1]] = value
+
+
 def apply_env_overrides(env: EnvConfig, changes: dict[str, Any]) -> EnvConfig:
-    """``env`` with ``changes`` ({field: value}); EnvConfig checks the values."""
+    """``env`` with ``changes`` ({field: value}; an ``aids`` mapping merges into ``env``'s aids
+    setting by setting, an aid mapped to None is switched off); EnvConfig checks the values."""
+    if isinstance(changes.get(AIDS), dict):
+        changes = {**changes, AIDS: merge(env.aids.to_dict(), changes[AIDS])}
     return dataclasses.replace(env, **changes)

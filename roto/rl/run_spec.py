@@ -97,4 +97,5 @@ def build_run_spec(
 def training_env(env: EnvConfig, agent_cfg: str | None, env_changes: dict[str, Any]) -> EnvConfig:
     """The training envs' config: ``env`` with the agent config's ``training_aids`` (for ``env``'s
     task and robot), then ``env_changes`` (the ``env.*`` overrides, which win)."""
-    return apply_env_overrides(env, {**load_training_aids(env.task, agent_cfg, env.robot), **env_changes})
+    with_aids = apply_env_overrides(env, {"aids": load_training_aids(env.task, agent_cfg, env.robot)})
+    return apply_env_overrides(with_aids, env_changes)

@@ -10,6 +10,7 @@ from typing import Any
 import yaml
 
 from roto.artifact_formats import FORMAT_KEY, check_format, format_stamp
+from roto.envs.aids.settings import aids_from_legacy_fields
 from roto.envs.config import EnvConfig
 from roto.result_files import write_text_atomic
 from roto.rl.config import AgentConfig, from_dict, to_dict
@@ -48,12 +49,13 @@ class TrainSettings:
         """Plain nested dict of builtins (for config.yaml and checkpoints)."""
         env = dataclasses.asdict(self.env)
         env["extra_groups"] = list(env["extra_groups"])
+        env["aids"] = self.env.aids.to_dict()  # the aids that are on
         return {"env": env, "total_steps": self.total_steps}
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> TrainSettings:
-        """Inverse of ``to_dict``."""
-        return cls(env=EnvConfig(**data["env"]), total_steps=int(data["total_steps"]))
+        """Inverse of ``to_dict``; a format-1 env (aid settings as flat fields) is read into today's."""
+        return cls(env=EnvConfig(**aids_from_legacy_fields(data["env"])), total_steps=int(data["total_steps"]))
 
 
 def run_config(settings: TrainSettings, agent: AgentConfig) -> dict[str, Any]:

@@ -93,7 +93,7 @@ def base_values(space: SearchSpace, env: EnvConfig, agent: AgentConfig) -> tuple
     for parameter in space.parameters:
         value: Any = tree
         for part in parameter.key.split("."):
-            value = value[part]
+            value = value[part] if isinstance(value, dict) else None  # None: under an aid that is off
         value = list(value) if isinstance(value, tuple) else value
         (inside if parameter.contains(value) else outside)[parameter.key] = value
     return inside, outside

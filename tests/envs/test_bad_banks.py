@@ -69,7 +69,7 @@ def compressed_corrupted(path):
 BANKS = {
     "a text file": (lambda p: (p.write_text("not a bank\n"), p)[1], "is not an .npz archive of named arrays"),
     "half a bank": (truncated, "is truncated or corrupted, not a readable .npz"),
-    "a corrupted stored member": (corrupted, "replay_starts"),
+    "a corrupted stored member": (corrupted, "aids.replayed_starts.bank"),
     "a corrupted compressed member": (compressed_corrupted, "is truncated or corrupted, not a readable .npz"),
     "object arrays": (
         lambda p: write_bank(p, robot=np.array(["shadow", None], dtype=object)),
@@ -90,7 +90,7 @@ def test_a_bad_bank_is_refused_by_the_env_naming_the_file(case, tmp_path):
     make_file, words = BANKS[case]
     path = make_file(tmp_path / "bank.npz")
     with pytest.raises(ValueError) as refused:
-        roto.make("baoding", robot="shadow", num_envs=1, replay_starts=str(path), replay_share=0.5)
+        roto.make("baoding", robot="shadow", num_envs=1, aids={"replayed_starts": {"bank": str(path), "share": 0.5}})
     message = str(refused.value)
     assert words in message and str(path) in message and "\n" not in message
     assert "allow_pickle" not in message and "unsafe" not in message
@@ -101,7 +101,7 @@ def test_roto_train_refuses_a_bad_bank_before_its_run_directory_exists(case, tmp
     path = BANKS[case][0](tmp_path / "bank.npz")
     run_dir = tmp_path / "run"
     args = ["train", "--task", "baoding", "--steps", "16", "--run_dir", str(run_dir), "--no_progress"]
-    assert main([*args, f"env.replay_starts={path}", "env.replay_share=0.5"]) == 2
+    assert main([*args, f"env.aids.replayed_starts.bank={path}", "env.aids.replayed_starts.share=0.5"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and BANKS[case][1] in err and "Traceback" not in err
     assert not run_dir.exists()
@@ -114,13 +114,13 @@ def test_a_plan_whose_bank_is_missing_for_one_hand_is_refused_by_its_check_and_d
     plan = tmp_path / "plan.yaml"
     plan.write_text(
         "variants:\n  ppo:\n    baoding: {agent_cfg: baoding, overrides: "
-        f'["env.replay_starts={starts}/{{robot}}.npz", env.replay_share=0.5]}}\n'
+        f'["env.aids.replayed_starts.bank={starts}/{{robot}}.npz", env.aids.replayed_starts.share=0.5]}}\n'
         "grids:\n  - {tasks: [baoding], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0]}\n"
     )
     for extra in (["--dry-run"], []):
         assert main(["olympiad", str(plan), "--root", str(tmp_path / "o"), *extra]) == 2
         err = capsys.readouterr().err
-        assert f"replay_starts '{starts}/allegro.npz' is not a file" in err and err.count("\n") == 1
+        assert f"aids.replayed_starts.bank '{starts}/allegro.npz' is not a file" in err and err.count("\n") == 1
     assert not (tmp_path / "o").exists()
 
 
@@ -128,6 +128,9 @@ def test_a_sweep_with_a_bad_bank_creates_no_study_so_the_fixed_command_runs(tmp_
     bad = BANKS["a NaN state"][0](tmp_path / "bad.npz")
     root = tmp_path / "sweeps"
     args = ["sweep", "--study", "s", "--root", str(root), "--task", "baoding", "--trials", "1", "--steps", "16"]
-    assert main([*args, "--set", f"env.replay_starts={bad}", "--set", "env.replay_share=0.5"]) == 2
+    assert (
+        main([*args, "--set", f"env.aids.replayed_starts.bank={bad}", "--set", "env.aids.replayed_starts.share=0.5"])
+        == 2
+    )
     assert "values that are not finite" in capsys.readouterr().err
     assert not (root / "s").exists()

@@ -15,9 +15,12 @@ BANK = SHADOW_BANK  # the Shadow reference controller's pre-swap states
 
 
 def replay_env(share: float, num_envs: int = 4, seed: int = 0, **kwargs):
-    return roto.make(
-        "baoding", robot="shadow", num_envs=num_envs, seed=seed, replay_starts=BANK, replay_share=share, **kwargs
-    )
+    return roto.make("baoding", robot="shadow", num_envs=num_envs, seed=seed, aids=replayed(BANK, share), **kwargs)
+
+
+def replayed(bank: str, share: float) -> dict:
+    """The aids section of an env that replays ``share`` of its starts from ``bank``."""
+    return {"replayed_starts": {"bank": bank, "share": share}}
 
 
 def run(env, steps: int = 40) -> list[dict[str, torch.Tensor]]:
@@ -89,31 +92,38 @@ def test_resume_continues_bit_identically_with_replayed_starts():
 
 
 def test_evaluation_envs_never_replay():
-    env = EnvConfig(task="baoding", replay_starts=BANK, replay_share=0.5)
+    env = EnvConfig(task="baoding", aids=replayed(BANK, 0.5))
     settings = TrainSettings(env=env)
-    assert settings.eval_env_config(8, 1).replay_share == 0.0 and settings.eval_env_config().replay_starts is None
-    assert settings.cpu_env_config(1).replay_share == 0.0
-    assert settings.env_config().replay_share == 0.5  # the training envs keep their aid
+    assert (
+        settings.eval_env_config(8, 1).aids.replayed_starts is None and settings.eval_env_config().aids.active() == {}
+    )
+    assert settings.cpu_env_config(1).aids.replayed_starts is None
+    assert settings.env_config().aids.replayed_starts.share == 0.5  # the training envs keep their aid
 
 
 @pytest.mark.parametrize(
     ("kwargs", "pattern"),
     [
-        ({"replay_share": 1.5, "replay_starts": BANK}, r"replay_share must be a number in \[0, 1\], got 1.5"),
-        ({"replay_share": 0.5}, r"replay_share 0.5 needs replay_starts"),
+        (replayed(BANK, 1.5), r"aids.replayed_starts.share must be a share in \[0, 1\], got 1.5"),
+        ({"replayed_starts": {"share": 0.5}}, r"aids.replayed_starts needs \['bank'\], got \{'share': 0.5\}"),
+        (
+            {"replayed_starts": {"bank": BANK, "shares": 0.5}},
+            r"unknown setting\(s\) \['shares'\] of aids.replayed_starts",
+        ),
+        ({"replay": {"bank": BANK}}, r"unknown training aid aids.replay; valid aids: \['replayed_starts'"),
     ],
 )
 def test_bad_replay_settings_are_refused(kwargs, pattern):
     with pytest.raises(ValueError, match=pattern):
-        EnvConfig(task="baoding", **kwargs)
+        EnvConfig(task="baoding", aids=kwargs)
 
 
 def test_a_missing_states_file_is_refused_by_the_env_and_a_run_s_config_still_loads():
-    with pytest.raises(ValueError, match=r"replay_starts '/nowhere/states.npz' is not a file"):
-        roto.make("baoding", replay_starts="/nowhere/states.npz", replay_share=0.5)
+    with pytest.raises(ValueError, match=r"aids.replayed_starts.bank '/nowhere/states.npz' is not a file"):
+        roto.make("baoding", aids=replayed("/nowhere/states.npz", 0.5))
     # a run trained with the aid is still evaluated where the file is gone (eval drops the aid)
     settings = TrainSettings.from_dict(
-        {"env": {"task": "baoding", "replay_starts": "/nowhere/states.npz", "replay_share": 0.5}, "total_steps": 10}
+        {"env": {"task": "baoding", "aids": replayed("/nowhere/states.npz", 0.5)}, "total_steps": 10}
     )
     env = roto.make(**vars(settings.eval_env_config(num_envs=1)))
     assert env.aid(ReplayedStarts) is None
@@ -122,7 +132,7 @@ def test_a_missing_states_file_is_refused_by_the_env_and_a_run_s_config_still_lo
 
 def test_states_of_another_hand_are_refused():
     with pytest.raises(ValueError, match=r"states recorded on robot 'shadow', not this env's 'allegro'"):
-        roto.make("baoding", robot="allegro", replay_starts=BANK, replay_share=0.5)
+        roto.make("baoding", robot="allegro", aids=replayed(BANK, 0.5))
 
 
 def test_both_backends_draw_the_same_replayed_starts():
@@ -141,7 +151,7 @@ def test_both_backends_draw_the_same_replayed_starts():
 @pytest.mark.parametrize("robot", ["shadow_lite", "allegro", "orca"])
 def test_every_hands_bank_replays_in_its_own_scene_with_the_task_state_it_was_recorded_in(robot):
     bank_file = BANK.replace("shadow_preswap", f"{robot}_preswap")
-    env = roto.make("baoding", robot=robot, num_envs=8, seed=0, replay_starts=bank_file, replay_share=1.0)
+    env = roto.make("baoding", robot=robot, num_envs=8, seed=0, aids=replayed(bank_file, 1.0))
     obs, _ = env.reset()
     saved, bank = np.load(bank_file), env.aid(ReplayedStarts).bank
     physics = torch.from_numpy(env.backend.physics_state())

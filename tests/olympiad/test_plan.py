@@ -161,8 +161,8 @@ def test_robot_in_an_override_becomes_each_cells_hand():
     cells = (("shadow", "task_critic_replay", 0.25), ("orca", "task_critic_more_aids_low_noise", 0.5))
     for robot, variant, share in cells:
         spec = cell_spec(plan, Cell("baoding", robot, "blind", variant, 1))
-        assert spec.env.replay_starts == f"benchmarks/results/baoding_reference/{robot}_preswap.npz"
-        assert spec.env.replay_share == share and spec.agent.ppo.epochs == 4 and spec.env.threads == 1
+        assert spec.env.aids.replayed_starts.bank == f"benchmarks/results/baoding_reference/{robot}_preswap.npz"
+        assert spec.env.aids.replayed_starts.share == share and spec.agent.ppo.epochs == 4 and spec.env.threads == 1
     assert {(c.robot, c.variant) for c in plan.cells} == {
         ("shadow", "task_critic_replay"),
         *((robot, "task_critic_more_aids") for robot in ("shadow_lite", "allegro")),
@@ -206,14 +206,18 @@ def test_the_more_aids_plan_adds_each_aid_to_the_recipe_for_shadow_lite():
     specs = {c.variant: cell_spec(plan, c) for c in plan.cells if c.robot == "shadow_lite"}
     assert len(specs) == 4
     assert all(
-        s.env.replay_starts.endswith("shadow_lite_preswap.npz") and s.agent.ppo.epochs == 4 for s in specs.values()
+        s.env.aids.replayed_starts.bank.endswith("shadow_lite_preswap.npz") and s.agent.ppo.epochs == 4
+        for s in specs.values()
     )
-    assert specs["tolerance"].env.tolerance_start == 0.025 and specs["tolerance"].env.replay_record_lead == 0
-    assert specs["record"].env.replay_record_lead == 10 and specs["record"].env.tolerance_start == 0.0
-    assert specs["share_half"].env.replay_share == 0.5
-    everything = specs["all_three"].env
-    assert (
-        everything.replay_share == 0.5 and everything.tolerance_start == 0.025 and everything.replay_record_lead == 10
+    tolerance, record = specs["tolerance"].env.aids, specs["record"].env.aids
+    assert tolerance.tolerance.start == 0.025 and tolerance.replayed_starts.record_lead == 0
+    assert record.replayed_starts.record_lead == 10 and record.tolerance is None
+    assert specs["share_half"].env.aids.replayed_starts.share == 0.5
+    everything = specs["all_three"].env.aids
+    assert (everything.replayed_starts.share, everything.tolerance.start, everything.replayed_starts.record_lead) == (
+        0.5,
+        0.025,
+        10,
     )
 
 
@@ -230,7 +234,7 @@ def test_the_more_aids_probe_of_a_hand_trains_as_its_20m_cell_does(robot, probe_
 
     probe = cell_spec(load_plan("baoding_v1_more_aids"), Cell("baoding", robot, "blind", probe_variant, 0))
     cell = cell_spec(load_plan("baoding_v1_cpu"), Cell("baoding", robot, "blind", cell_variant, 0))
-    assert probe.differences(cell) == {} and probe.env.replay_starts.endswith(f"{robot}_preswap.npz")
+    assert probe.differences(cell) == {} and probe.env.aids.replayed_starts.bank.endswith(f"{robot}_preswap.npz")
     assert (probe.steps, cell.steps) == (5_000_000, 20_000_000)
 
 
@@ -264,7 +268,7 @@ def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(plan_nam
     cell = cell_spec(plan, Cell("baoding", robot, "blind", variant, 0))
     config = f"baoding_cpu_{robot}"
     packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=1)
-    assert packaged.differences(cell) == {} and packaged.env.replay_starts.endswith(f"{robot}_preswap.npz")
+    assert packaged.differences(cell) == {} and packaged.env.aids.replayed_starts.bank.endswith(f"{robot}_preswap.npz")
 
 
 def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_to_its_own():
@@ -278,10 +282,9 @@ def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_
     three = cell_spec(plan, Cell("baoding", "shadow", "blind", variant, 1))
     one = cell_spec(main, Cell("baoding", "shadow", "blind", "task_critic_replay", 1))
     assert three.differences(one) == {
-        "env.replay_share": (0.5, 0.25),
-        "env.replay_record_lead": (10, 0),
-        "env.tolerance_start": (0.025, 0.0),
-        "env.tolerance_target": (2, 1.0),
+        "env.aids.replayed_starts.share": (0.5, 0.25),
+        "env.aids.replayed_starts.record_lead": (10, 0),
+        "env.aids.tolerance": ({"start": 0.025, "target": 2}, None),
     }
 
 
@@ -294,12 +297,12 @@ def test_each_ablation_changes_exactly_its_part_of_the_baoding_recipe():
     recipe = cell_spec(plan, Cell("baoding", "shadow", "blind", "recipe", 1))
     assert recipe.differences(cell_spec(main, Cell("baoding", "shadow", "blind", "task_critic_more_aids", 1))) == {}
     bank = "benchmarks/results/baoding_reference/shadow_preswap.npz"
+    replayed = {"bank": bank, "share": 0.5, "record_lead": 10, "record_capacity": 1024}
     expected = {
         "recipe": {},
-        "no_replay": {"env.replay_starts": (None, bank), "env.replay_share": (0.0, 0.5),
-                      "env.replay_record_lead": (0, 10)},
-        "no_own_swaps": {"env.replay_record_lead": (0, 10)},
-        "no_tolerance": {"env.tolerance_start": (0.0, 0.025), "env.tolerance_target": (1.0, 2)},
+        "no_replay": {"env.aids.replayed_starts": (None, replayed)},
+        "no_own_swaps": {"env.aids.replayed_starts.record_lead": (0, 10)},
+        "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2})},
         "plain_critic": {"agent.network.critic": (None, ["tactile", "proprio", "privileged", "task"])},
         "roto_epochs": {"agent.ppo.epochs": (8, 4)},
         "std_bound": {"agent.network.max_log_std": (0.0, 2.0)},
@@ -325,7 +328,10 @@ def test_the_low_noise_plan_trains_orcas_recipe_on_other_hands_as_the_ablation_d
     assert shadow.differences(cell_spec(ablations, Cell("baoding", "shadow", "blind", "low_noise", 1))) == {}
     for cell in plan.cells:
         spec = cell_spec(plan, cell)
-        assert spec.env.replay_starts.endswith(f"{cell.robot}_preswap.npz") and spec.agent.network.max_log_std == -1.386
+        assert (
+            spec.env.aids.replayed_starts.bank.endswith(f"{cell.robot}_preswap.npz")
+            and spec.agent.network.max_log_std == -1.386
+        )
 
 
 def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_starts():
@@ -335,7 +341,7 @@ def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_st
     cycle = cell_spec(plan, Cell("baoding", "allegro", "blind", "cycle_low_noise", 0))
     low = cell_spec(plan, Cell("baoding", "allegro", "blind", "all_three_low_noise", 0))
     bank = "benchmarks/results/baoding_reference/allegro_cycle.npz"
-    assert cycle.differences(low) == {"env.replay_starts": (bank, bank.replace("cycle", "preswap"))}
+    assert cycle.differences(low) == {"env.aids.replayed_starts.bank": (bank, bank.replace("cycle", "preswap"))}
     assert pathlib.Path(bank).is_file()
 
 
@@ -347,11 +353,17 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
 
     plan = load_plan("baoding_v1_round")
     recipe = build_run_spec("baoding", "orca", "blind", "baoding_cpu_orca", [], plan.steps, num_envs=128, threads=1)
-    bank, round_bank = recipe.env.replay_starts, "benchmarks/results/baoding_reference/orca_round_preswap.npz"
+    bank, round_bank = (
+        recipe.env.aids.replayed_starts.bank,
+        "benchmarks/results/baoding_reference/orca_round_preswap.npz",
+    )
     expected = {
-        "round_swaps": {"env.swap_min_turn": (0.25, 0.0)},
-        "round_bank": {"env.replay_starts": (round_bank, bank)},
-        "round_bank_round_swaps": {"env.replay_starts": (round_bank, bank), "env.swap_min_turn": (0.25, 0.0)},
+        "round_swaps": {"env.aids.round_swaps": ({"min_turn": 0.25}, None)},
+        "round_bank": {"env.aids.replayed_starts.bank": (round_bank, bank)},
+        "round_bank_round_swaps": {
+            "env.aids.replayed_starts.bank": (round_bank, bank),
+            "env.aids.round_swaps": ({"min_turn": 0.25}, None),
+        },
     }
     assert [(c.variant, c.seed) for c in plan.cells] == [
         ("round_swaps", 0),
@@ -383,7 +395,8 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
     recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu_shadow", [], plan.steps, num_envs=128, threads=1)
     round_bank = "benchmarks/results/baoding_reference/shadow_round_preswap.npz"
     assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
-        "env.replay_starts": (round_bank, recipe.env.replay_starts), "env.swap_min_turn": (0.25, 0.0),
+        "env.aids.replayed_starts.bank": (round_bank, recipe.env.aids.replayed_starts.bank),
+        "env.aids.round_swaps": ({"min_turn": 0.25}, None),
         "env.seed": (3, 0),
     }  # fmt: skip
     assert pathlib.Path(round_bank).is_file()

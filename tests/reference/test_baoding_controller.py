@@ -36,7 +36,7 @@ def test_from_a_recorded_preswap_state_the_controller_swaps_again(seed):
     them through its own replayed starts."""
     with np.load(PRESWAP) as saved:
         assert set(np.atleast_1d(saved["lead_steps"])) == {10} and len(saved["physics"]) >= 100
-    env = reference_env("shadow", seed=seed, replay_starts=str(PRESWAP), replay_share=1.0)
+    env = reference_env("shadow", seed=seed, aids={"replayed_starts": {"bank": str(PRESWAP), "share": 1.0}})
     env.reset()
     physics = torch.from_numpy(env.backend.physics_state()[0, 1 : 1 + env.model.nq])
     assert (env.aid(ReplayedStarts).bank.qpos == physics).all(dim=1).any()  # a recorded state, exactly
@@ -55,7 +55,9 @@ def test_from_a_recorded_preswap_state_the_controller_swaps_again(seed):
 
 def test_a_reference_episode_reports_the_turns_of_the_ball_pair_over_its_own_steps():
     """The path metrics of a short episode started just before a swap: the pair turns while it swaps."""
-    env = reference_env("shadow", seed=0, episode_steps=30, replay_starts=str(PRESWAP), replay_share=1.0)
+    env = reference_env(
+        "shadow", seed=0, episode_steps=30, aids={"replayed_starts": {"bank": str(PRESWAP), "share": 1.0}}
+    )
     controller = controller_for(env)
     try:
         result = run_reference_episode(controller)
@@ -76,7 +78,7 @@ def test_the_controller_needs_one_world_on_the_cpu():
 
 def test_preswap_states_of_another_hand_are_refused():
     with pytest.raises(ValueError, match="states recorded on robot 'shadow', not this env's 'allegro'"):
-        reference_env("allegro", seed=0, replay_starts=str(PRESWAP), replay_share=1.0)
+        reference_env("allegro", seed=0, aids={"replayed_starts": {"bank": str(PRESWAP), "share": 1.0}})
 
 
 def test_preswap_states_are_recorded_at_each_lead_the_history_reaches(tmp_path):

@@ -22,21 +22,34 @@ def test_env_overrides_set_any_env_field_and_win_over_flags():
 def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_wins(tmp_path):
     base, banks = tmp_path / "aided.yaml", pathlib.Path(SHADOW_BANK).parent  # the reference controller's banks
     base.write_text(
-        f"extends: baoding_cpu\ntraining_aids:\n  replay_starts: {banks}/{{robot}}_preswap.npz\n"
-        "  replay_share: 0.25\n  tolerance_start: 0.025\n"
+        "extends: baoding_cpu\ntraining_aids:\n"
+        f"  replayed_starts: {{bank: '{banks}/{{robot}}_preswap.npz', share: 0.25}}\n"
+        "  tolerance: {start: 0.025}\n"
     )
-    (tmp_path / "more.yaml").write_text("extends: aided.yaml\ntraining_aids:\n  replay_share: 0.5\n")
-    spec = build_run_spec("Baoding", "Allegro", "blind", str(tmp_path / "more.yaml"), ["env.tolerance_start=0.02"])
+    (tmp_path / "more.yaml").write_text("extends: aided.yaml\ntraining_aids:\n  replayed_starts: {share: 0.5}\n")
+    overrides = ["env.aids.tolerance.start=0.02", "env.aids.round_swaps={}"]
+    spec = build_run_spec("Baoding", "Allegro", "blind", str(tmp_path / "more.yaml"), overrides)
     assert (spec.env.task, spec.env.robot) == ("baoding", "allegro")  # names in any case, as roto.make takes them
-    assert (spec.env.replay_starts, spec.env.replay_share) == (f"{banks}/allegro_preswap.npz", 0.5)  # through extends
-    assert spec.env.tolerance_start == 0.02 and spec.agent.ppo.epochs == 4  # the override wins; baoding_cpu's agent
+    replayed = spec.env.aids.replayed_starts
+    assert (replayed.bank, replayed.share) == (f"{banks}/allegro_preswap.npz", 0.5)  # through extends
+    assert (
+        spec.env.aids.tolerance.start == 0.02 and spec.agent.ppo.epochs == 4
+    )  # the override wins; baoding_cpu's agent
+    assert spec.env.aids.round_swaps.min_turn == 0.25  # switched on by an override, at its default
+    off = build_run_spec("baoding", "allegro", "blind", str(tmp_path / "more.yaml"), ["env.aids.tolerance=null"])
+    assert off.env.aids.tolerance is None and off.env.aids.replayed_starts == replayed
     assert spec.env.without_training_aids() == build_run_spec("baoding", "allegro", "blind", "baoding_cpu").env
     base.write_text("extends: baoding_cpu\ntraining_aids:\n  num_envs: 4096\n")
-    with pytest.raises(ValueError, match=r"\['num_envs'\] are not training aids; valid keys: \['replay_starts'"):
+    with pytest.raises(ValueError, match=r"unknown training aid aids.num_envs; valid aids: \['replayed_starts'"):
         build_run_spec("baoding", "allegro", "blind", str(base))
-    base.write_text("extends: baoding_cpu\ntraining_aids: [replay_share]\n")
-    with pytest.raises(ValueError, match=r"training_aids must be a mapping of env fields to values, got \[.replay"):
+    base.write_text("extends: baoding_cpu\ntraining_aids: [replayed_starts]\n")
+    with pytest.raises(ValueError, match=r"training_aids must be a mapping of aids to their settings, got \[.replayed"):
         build_run_spec("baoding", "allegro", "blind", str(base))
+    base.write_text("extends: baoding_cpu\ntraining_aids:\n  replay_share: 0.5\n")  # the flat form of format 1
+    with pytest.raises(ValueError, match=r"\['replay_share'\] are now set per aid, as \['replayed_starts.share'\]"):
+        build_run_spec("baoding", "allegro", "blind", str(base))
+    with pytest.raises(ValueError, match=r"env.replay_share=0.5.*set per aid now: env.aids.replayed_starts.share="):
+        build_run_spec("baoding", "allegro", "blind", "baoding_cpu_shadow", ["env.replay_share=0.5"])
 
 
 @pytest.mark.parametrize(

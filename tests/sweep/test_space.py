@@ -28,11 +28,13 @@ def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load
     assert noise.parameters[:7] == quick.parameters and noise.parameters[7].key == "network.init_log_std"
     bank = "benchmarks/results/baoding_reference/shadow_preswap.npz"
     baoding = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu",
-                         [f"env.replay_starts={bank}", "env.replay_share=0.25"])  # fmt: skip
+                         [f"env.aids.replayed_starts.bank={bank}", "env.aids.replayed_starts.share=0.25"])  # fmt: skip
     assert [p.key for p in baoding.parameters] == [
-        *(p.key for p in plain.parameters), "network.max_log_std", "env.replay_share"
+        *(p.key for p in plain.parameters), "network.max_log_std", "env.aids.replayed_starts.share"
     ]  # fmt: skip
-    with pytest.raises(ValueError, match=r"replay_share 0\.1 needs replay_starts"):  # the bank is the study's to set
+    with pytest.raises(
+        ValueError, match=r"aids.replayed_starts needs \['bank'\], got \{'share': 0\.1\}"
+    ):  # the bank is the study's to set
         load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu")
     recipe = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu_shadow")  # its own bank
     assert [p.key for p in recipe.parameters] == [p.key for p in baoding.parameters]

@@ -227,7 +227,9 @@ def test_the_enqueued_base_has_the_training_aids_of_its_agent_config(tmp_path):
     study, _ = open_study(settings)
     space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
     inside, _ = enqueue_base(study, settings, space)
-    assert inside["env.replay_share"] == 0.5 and inside["ppo.epochs"] == 4  # baoding_cpu_shadow's, not defaults
+    assert (
+        inside["env.aids.replayed_starts.share"] == 0.5 and inside["ppo.epochs"] == 4
+    )  # baoding_cpu_shadow's, not defaults
 
 
 def test_joining_a_study_with_other_settings_is_an_error(tmp_path):

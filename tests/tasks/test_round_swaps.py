@@ -112,21 +112,23 @@ def test_the_task_pays_every_round_swap_one_swing_and_counts_all_swaps():
 
 
 def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
-    env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, swap_min_turn=0.25)
+    env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids={"round_swaps": {"min_turn": 0.25}})
     assert float(env.task_state.min_turn) == 0.25
     assert float(roto.make("baoding", robot="shadow", num_envs=2, seed=0).task_state.min_turn) == 0.0
-    settings = TrainSettings(env=EnvConfig(task="baoding", swap_min_turn=0.25))
-    assert settings.eval_env_config(4).swap_min_turn == 0.0 and settings.env_config().swap_min_turn == 0.25
+    settings = TrainSettings(env=EnvConfig(task="baoding", aids={"round_swaps": {}}))  # a quarter turn by default
+    assert (
+        settings.eval_env_config(4).aids.round_swaps is None and settings.env_config().aids.round_swaps.min_turn == 0.25
+    )
 
 
 @pytest.mark.parametrize(
-    ("kwargs", "pattern"),
+    ("task", "min_turn", "pattern"),
     [
-        ({"task": "bounce", "swap_min_turn": 0.25}, r"task 'bounce' has none"),
-        ({"task": "baoding", "swap_min_turn": 0.75}, r"swap_min_turn must be a number of turns in \[0, 0.5\].*0.75"),
-        ({"task": "baoding", "swap_min_turn": -0.1}, r"got -0.1"),
+        ("bounce", 0.25, r"aids.round_swaps applies to a task with swaps \(baoding\); task 'bounce' has none"),
+        ("baoding", 0.75, r"aids.round_swaps.min_turn must be a number of turns in \[0, 0.5\], got 0.75"),
+        ("baoding", -0.1, r"got -0.1"),
     ],
 )
-def test_bad_swap_min_turn_is_refused(kwargs, pattern):
+def test_bad_swap_min_turn_is_refused(task, min_turn, pattern):
     with pytest.raises(ValueError, match=pattern):
-        EnvConfig(**kwargs)
+        EnvConfig(task=task, aids={"round_swaps": {"min_turn": min_turn}})

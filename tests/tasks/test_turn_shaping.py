@@ -59,22 +59,25 @@ def test_a_pair_carried_round_earns_per_turn_either_way_and_a_swing_earns_nothin
 
 
 def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
-    env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, turn_reward=20.0)
+    env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids={"turn_shaping": {"per_turn": 20.0}})
     assert float(env.task_state.turn_reward) == 20.0 and [type(a).__name__ for a in env.aids] == ["TurnShaping"]
     assert float(roto.make("baoding", robot="shadow", num_envs=2, seed=0).task_state.turn_reward) == 0.0
-    settings = TrainSettings(env=EnvConfig(task="baoding", turn_reward=20.0))
-    assert settings.eval_env_config(4).turn_reward == 0.0 and settings.env_config().turn_reward == 20.0
+    settings = TrainSettings(env=EnvConfig(task="baoding", aids={"turn_shaping": {"per_turn": 20.0}}))
+    assert (
+        settings.eval_env_config(4).aids.turn_shaping is None and settings.env_config().aids.turn_shaping.per_turn == 20
+    )
+    assert float(roto.make(**vars(settings.eval_env_config(2))).task_state.turn_reward) == 0.0
 
 
 @pytest.mark.parametrize(
-    ("kwargs", "pattern"),
+    ("task", "per_turn", "pattern"),
     [
-        ({"task": "bounce", "turn_reward": 20.0}, r"turn_reward applies to a task with a ball pair.*'bounce'"),
-        ({"task": "baoding", "turn_reward": -1.0}, r"turn_reward must be a reward per turn in \[0, 1000\].*-1.0"),
-        ({"task": "baoding", "turn_reward": float("nan")}, r"got nan"),
-        ({"task": "baoding", "turn_reward": "20"}, r"got '20'"),
+        ("bounce", 20.0, r"aids.turn_shaping applies to a task with a ball pair \(baoding\); task 'bounce' has none"),
+        ("baoding", -1.0, r"aids.turn_shaping.per_turn must be a reward per turn in \[0, 1000\], got -1.0"),
+        ("baoding", float("nan"), r"got nan"),
+        ("baoding", "20", r"got '20'"),
     ],
 )
-def test_bad_turn_reward_is_refused(kwargs, pattern):
+def test_bad_turn_reward_is_refused(task, per_turn, pattern):
     with pytest.raises(ValueError, match=pattern):
-        EnvConfig(**kwargs)
+        EnvConfig(task=task, aids={"turn_shaping": {"per_turn": per_turn}})

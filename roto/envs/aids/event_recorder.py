@@ -3,7 +3,7 @@
 Reference-state initialisation from the agent's own successes: where the task's headline metric
 rises in a world (a Baoding swap, a Bounce bounce), the state that world was in ``lead`` control
 steps earlier joins a bank of at most ``capacity`` states (the oldest replaced first), from which
-training episodes may start beside the recorded file's states (``EnvConfig.replay_record_lead``,
+training episodes may start beside the recorded file's states (``ReplayedStartsSettings.record_lead``,
 ``roto.envs.aids.replayed_starts``). Only states of the same episode count: the event must come more than
 ``lead`` steps after the episode's start.
 
@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import torch
 
 from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
+from roto.envs.aids.settings import ReplayedStartsSettings
 from roto.envs.replay_starts import ReplayBank
 
 
@@ -121,19 +122,19 @@ class EventRecorder:
 
 class RecordedEvents(TrainingAid):
     """The aid: records the training envs' own states ``lead`` steps before each rise of the task's
-    headline metric (``EnvConfig.replay_record_lead``); ``ReplayedStarts`` draws from them beside
+    headline metric (``ReplayedStartsSettings.record_lead``); ``ReplayedStarts`` draws from them beside
     its file's states."""
 
     state_key = "event_recorder"
     watches_steps = True
 
-    def __init__(self, host: AidHost, task_fields: tuple[str, ...]) -> None:
-        config, b = host.config, host.config.num_envs
+    def __init__(self, host: AidHost, settings: ReplayedStartsSettings, task_fields: tuple[str, ...]) -> None:
+        b = host.config.num_envs
         sizes = {"qpos": host.model.nq, "qvel": host.model.nv, "target": host.robot.num_actions}
         like = {name: torch.zeros(b, size, dtype=torch.float64, device=host.device) for name, size in sizes.items()}
         like.update({f"task/{name}": getattr(host.task_state, name) for name in task_fields})
         self.task_fields = task_fields
-        self.recorder = EventRecorder.empty(config.replay_record_lead, config.replay_record_capacity, like)
+        self.recorder = EventRecorder.empty(settings.record_lead, settings.record_capacity, like)
         self.device = host.device
 
     def observe(self, step: StepContext) -> None:

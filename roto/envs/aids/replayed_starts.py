@@ -1,6 +1,6 @@
 """The replayed-starts aid: a share of the training episodes starts from recorded states.
 
-Each start is, with probability ``EnvConfig.replay_share``, a state drawn uniformly from the bank
+Each start is, with probability ``ReplayedStartsSettings.share``, a state drawn uniformly from the bank
 of recorded states (``roto.envs.replay_starts``; with ``RecordedEvents``, also from the states the
 envs recorded themselves), with the task state it was recorded in, kept as recorded; otherwise the
 draw it wraps (the task's own starts).
@@ -12,28 +12,28 @@ import torch
 
 from roto.envs.aids.event_recorder import RecordedEvents, with_recorded
 from roto.envs.aids.protocol import AidHost, DrawStarts, StartRows, TrainingAid
+from roto.envs.aids.settings import ReplayedStartsSettings
 from roto.envs.replay_starts import ReplayBank, load_replay_bank
 
 
 class ReplayedStarts(TrainingAid):
-    """Draws ``replay_share`` of the starts from the config's bank (``replay_starts``), plus the
+    """Draws ``share`` of the starts from the settings' bank, plus the
     states ``recorded`` holds when the envs record their own."""
 
     state_key = "replay_bank"
 
-    def __init__(self, host: AidHost) -> None:
-        robot, task, config = host.robot, host.task, host.config
-        path = config.replay_starts
-        bank = load_replay_bank(path, host.model, robot.name, task.name, host.task_state, robot.num_actions)
-        self.bank, self.share, self.device = bank.to(host.device), config.replay_share, host.device
+    def __init__(self, host: AidHost, settings: ReplayedStartsSettings) -> None:
+        robot, task = host.robot, host.task
+        bank = load_replay_bank(settings.bank, host.model, robot.name, task.name, host.task_state, robot.num_actions)
+        self.bank, self.share, self.device = bank.to(host.device), settings.share, host.device
         self.first_frame = host.first_frame
         self.recorded: RecordedEvents | None = None
         """The envs' own recorded states, drawn alike beside the bank's (``record_own_events``)."""
 
-    def record_own_events(self, host: AidHost) -> RecordedEvents:
+    def record_own_events(self, host: AidHost, settings: ReplayedStartsSettings) -> RecordedEvents:
         """The aid that records the envs' own states before each event, with this bank's task
         fields; its states are drawn from beside the bank's from now on."""
-        self.recorded = RecordedEvents(host, tuple(self.bank.task))
+        self.recorded = RecordedEvents(host, settings, tuple(self.bank.task))
         return self.recorded
 
     def start_task_fields(self) -> tuple[str, ...]:

@@ -4,9 +4,9 @@ benchmark's as the training episodes succeed.
 For a task with a success radius (Baoding's latch radius, the task parameter ``success_radius``): the radius is
 ``end + (start - end) * max(0, 1 - mean / target)``, where ``mean`` is a running mean of the headline
 metric (Baoding: rotations) over the training episodes that ended so far (each ended episode
-weighs ``EPISODE_WEIGHT``), ``start`` is ``EnvConfig.tolerance_start`` and ``end`` the task's own
+weighs ``EPISODE_WEIGHT``), ``start`` is ``ToleranceSettings.start`` and ``end`` the task's own
 radius. So the radius is ``start`` while no episode succeeds, the task's own once the episodes
-reach ``EnvConfig.tolerance_target`` on average, and widens again if they fall back. The update
+reach ``ToleranceSettings.target`` on average, and widens again if they fall back. The update
 runs on the env's device in fixed shapes, never reading it. Evaluation envs never use it
 (``EnvConfig.without_training_aids``).
 """
@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import torch
 
 from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
+from roto.envs.aids.settings import ToleranceSettings
 
 EPISODE_WEIGHT = 0.01
 """Weight of one ended episode in the running mean (about the last hundred episodes count)."""
@@ -58,16 +59,15 @@ class ToleranceCurriculum:
 
 class ToleranceAid(TrainingAid):
     """The aid: a ``ToleranceCurriculum`` fed the headline metric of every ended training episode,
-    setting the task's ``success_radius`` parameter (``EnvConfig.tolerance_start`` > 0)."""
+    setting the task's ``success_radius`` parameter (the ``tolerance`` aid)."""
 
     state_key = "tolerance_curriculum"
     watches_steps = True
 
-    def __init__(self, host: AidHost) -> None:
-        config = host.config
+    def __init__(self, host: AidHost, settings: ToleranceSettings) -> None:
         mean = torch.zeros((), dtype=torch.float64, device=host.device)
         end = host.task.parameters["success_radius"]
-        self.curriculum = ToleranceCurriculum(config.tolerance_start, end, config.tolerance_target, mean)
+        self.curriculum = ToleranceCurriculum(settings.start, end, settings.target, mean)
         self.task, self.task_state = host.task, host.task_state
         self.task.set_parameter(self.task_state, "success_radius", self.curriculum.radius())
 

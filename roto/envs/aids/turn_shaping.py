@@ -1,4 +1,4 @@
-"""The turn-shaping aid: a training env earns ``EnvConfig.turn_reward`` per turn the pair's net
+"""The turn-shaping aid: a training env earns ``TurnShapingSettings.per_turn`` per turn the pair's net
 turning this episode grows, and gives it back as it shrinks (``roto.tasks.round_swaps.turn_shaping``),
 so carrying the balls round pays and swinging them out and back does not. It only sets the task's
 ``turn_reward`` parameter; the task does the rest (a "turn" reward term)."""
@@ -6,10 +6,11 @@ so carrying the balls round pays and swinging them out and back does not. It onl
 from __future__ import annotations
 
 from roto.envs.aids.protocol import AidHost, TrainingAid
+from roto.envs.aids.settings import TurnShapingSettings
 
 
 class TurnShaping(TrainingAid):
     """Sets the task parameter ``turn_reward`` once, when the env is built."""
 
-    def __init__(self, host: AidHost) -> None:
-        host.task.set_parameter(host.task_state, "turn_reward", host.config.turn_reward)
+    def __init__(self, host: AidHost, settings: TurnShapingSettings) -> None:
+        host.task.set_parameter(host.task_state, "turn_reward", settings.per_turn)

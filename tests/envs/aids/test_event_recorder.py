@@ -109,11 +109,11 @@ def own_bank(path):
     return str(path)
 
 
-def recording_env(bank, **kwargs):
+def recording_env(bank, share=0.5, **kwargs):
     import roto
 
-    options = {"replay_starts": bank, "replay_share": 0.5, "replay_record_lead": LEAD, "seed": 1, **kwargs}
-    return roto.make("bounce", robot="shadow", obs_mode="state", num_envs=WORLDS, **options)
+    aids = {"replayed_starts": {"bank": bank, "share": share, "record_lead": LEAD}}
+    return roto.make("bounce", robot="shadow", obs_mode="state", num_envs=WORLDS, aids=aids, **{"seed": 1, **kwargs})
 
 
 def play(env, steps, logs=None):
@@ -175,10 +175,10 @@ def test_an_env_records_its_own_states_lead_steps_before_each_bounce(tmp_path):
 
 def test_a_resumed_env_records_and_draws_as_the_original(tmp_path):
     bank = own_bank(tmp_path / "bank.npz")
-    first = recording_env(bank, replay_share=0.9)
+    first = recording_env(bank, share=0.9)
     play(first, 100)
     saved = first.state_dict()
-    second = recording_env(bank, replay_share=0.9, seed=7)
+    second = recording_env(bank, share=0.9, seed=7)
     second.load_state_dict(saved)
     assert int(second.aid(RecordedEvents).recorder.recorded) == int(first.aid(RecordedEvents).recorder.recorded) > 0
     gen = torch.Generator().manual_seed(2)
@@ -195,7 +195,7 @@ def test_a_resumed_env_draws_its_starts_when_the_original_does_from_the_states_r
     resumed env would draw from fewer recorded states than the original later does."""
     from roto.scripted import ScriptedBounce
 
-    first = recording_env(own_bank(tmp_path / "bank.npz"), replay_share=0.9)
+    first = recording_env(own_bank(tmp_path / "bank.npz"), share=0.9)
     policy = ScriptedBounce(first)
     obs, _ = first.reset()
     for _ in range(400):  # the scripted policy bounces: events to record; drops: resets
@@ -204,7 +204,7 @@ def test_a_resumed_env_draws_its_starts_when_the_original_does_from_the_states_r
         if 0 < first._starts.remaining < WORLDS and first.aid(RecordedEvents).recorder.recorded > 0:
             break
     assert 0 < first._starts.remaining < WORLDS
-    second = recording_env(own_bank(tmp_path / "other.npz"), replay_share=0.9, seed=7)
+    second = recording_env(own_bank(tmp_path / "other.npz"), share=0.9, seed=7)
     second.load_state_dict(first.state_dict())
     recorded, drew_after_new_states = int(first.aid(RecordedEvents).recorder.recorded), False
     for _ in range(600):
@@ -226,12 +226,14 @@ def test_recording_needs_replayed_starts_and_evaluation_never_records():
     from roto.envs.config import EnvConfig
     from roto.rl.settings import TrainSettings
 
-    with pytest.raises(ValueError, match="replay_record_lead 10 records states for replayed starts, but replay_share"):
-        EnvConfig(task="baoding", replay_record_lead=10)
-    with pytest.raises(ValueError, match="replay_record_capacity must be an integer >= 1, got 0"):
-        EnvConfig(task="baoding", replay_record_capacity=0)
-    config = EnvConfig(task="bounce", replay_starts="bank.npz", replay_share=0.5, replay_record_lead=10)
-    assert TrainSettings(env=config).eval_env_config(4).replay_record_lead == 0
+    with pytest.raises(
+        ValueError, match=r"record_lead 10 records states for replayed starts, but aids.replayed_starts.share"
+    ):
+        EnvConfig(task="baoding", aids={"replayed_starts": {"bank": "b.npz", "share": 0.0, "record_lead": 10}})
+    with pytest.raises(ValueError, match=r"aids\.replayed_starts\.record_capacity must be an integer >= 1, got 0"):
+        EnvConfig(task="baoding", aids={"replayed_starts": {"bank": "b.npz", "record_capacity": 0}})
+    config = EnvConfig(task="bounce", aids={"replayed_starts": {"bank": "bank.npz", "share": 0.5, "record_lead": 10}})
+    assert TrainSettings(env=config).eval_env_config(4).aids.replayed_starts is None
 
 
 def test_a_reset_mid_run_starts_every_metric_over(tmp_path):

@@ -5,7 +5,7 @@ import pytest
 import torch
 
 import roto
-from roto.envs.aids import StepContext
+from roto.envs.aids.protocol import StepContext
 from roto.envs.aids.tolerance import EPISODE_WEIGHT, ToleranceAid, ToleranceCurriculum
 from roto.envs.config import EnvConfig
 from roto.rl.settings import TrainSettings
@@ -45,8 +45,11 @@ def test_a_wider_radius_latches_a_ball_the_benchmarks_would_not():
     assert baoding_rule(pos, targets, none, latches, torch.tensor(0.025, dtype=torch.float64))[3][0, 0]
 
 
+TOLERANCE = {"tolerance": {"start": 0.03, "target": 2.0}}
+
+
 def test_a_baoding_env_starts_wide_narrows_as_its_episodes_rotate_and_resumes_exactly():
-    env = roto.make("baoding", robot="shadow", num_envs=4, seed=0, tolerance_start=0.03, tolerance_target=2.0)
+    env = roto.make("baoding", robot="shadow", num_envs=4, seed=0, aids=TOLERANCE)
     assert float(env.task_state.radius) == pytest.approx(0.03)
     env.reset()
     env.task_state.swaps.fill_(2)  # every world has made one rotation when its episode ends
@@ -56,7 +59,7 @@ def test_a_baoding_env_starts_wide_narrows_as_its_episodes_rotate_and_resumes_ex
     mean = 1.0 - (1.0 - EPISODE_WEIGHT) ** 4
     assert float(env.task_state.radius) == pytest.approx(SUCCESS_RADIUS + 0.02 * (1.0 - mean / 2.0))
     saved = env.state_dict()
-    other = roto.make("baoding", robot="shadow", num_envs=4, seed=5, tolerance_start=0.03, tolerance_target=2.0)
+    other = roto.make("baoding", robot="shadow", num_envs=4, seed=5, aids=TOLERANCE)
     other.load_state_dict(saved)
     assert torch.equal(other.aid(ToleranceAid).curriculum.mean, env.aid(ToleranceAid).curriculum.mean)
     assert torch.equal(other.task_state.radius, env.task_state.radius)
@@ -65,23 +68,28 @@ def test_a_baoding_env_starts_wide_narrows_as_its_episodes_rotate_and_resumes_ex
 
 
 @pytest.mark.parametrize(
-    ("kwargs", "pattern"),
+    ("task", "settings", "pattern"),
     [
-        ({"task": "bounce", "tolerance_start": 0.02}, r"task 'bounce' has none"),
-        ({"task": "baoding", "tolerance_start": 0.005}, r"at least the task's own radius 0.01 m"),
-        ({"task": "baoding", "tolerance_start": 0.02, "tolerance_target": 0.0}, r"tolerance_target > 0"),
-        ({"task": "baoding", "tolerance_start": -1.0}, r"tolerance_start must be a number >= 0, got -1.0"),
+        ("bounce", {"start": 0.02}, r"aids.tolerance applies to a task with a success radius.*'bounce' has none"),
+        (
+            "baoding",
+            {"start": 0.005},
+            r"aids.tolerance.start must be a radius \(m\) no smaller than the task's own 0.01",
+        ),
+        ("baoding", {"start": 0.02, "target": 0.0}, r"aids.tolerance.target must be a headline metric.*got 0.0"),
+        ("baoding", {"start": -1.0}, r"got -1.0"),
+        ("baoding", {"target": 2.0}, r"aids.tolerance needs \['start'\]"),
     ],
 )
-def test_bad_tolerance_settings_are_refused(kwargs, pattern):
+def test_bad_tolerance_settings_are_refused(task, settings, pattern):
     with pytest.raises(ValueError, match=pattern):
-        EnvConfig(**kwargs)
+        EnvConfig(task=task, aids={"tolerance": settings})
 
 
 def test_evaluation_envs_use_the_benchmarks_radius():
-    settings = TrainSettings(env=EnvConfig(task="baoding", tolerance_start=0.025))
-    assert settings.eval_env_config(4).tolerance_start == 0.0 and settings.cpu_env_config(1).tolerance_start == 0.0
-    assert settings.env_config().tolerance_start == 0.025
+    settings = TrainSettings(env=EnvConfig(task="baoding", aids={"tolerance": {"start": 0.025}}))
+    assert settings.eval_env_config(4).aids.tolerance is None and settings.cpu_env_config(1).aids.tolerance is None
+    assert settings.env_config().aids.tolerance.start == 0.025
 
 
 def test_training_logs_the_radius_and_config_yaml_names_the_aid(tmp_path):
@@ -105,11 +113,13 @@ def test_training_logs_the_radius_and_config_yaml_names_the_aid(tmp_path):
         str(run_dir),
         "--no_progress",
     ]
-    assert main([*args, *TINY, "env.tolerance_start=0.03"]) == 0
+    assert main([*args, *TINY, "env.aids.tolerance.start=0.03"]) == 0
     radii = [
         float(r["value"])
         for r in csv.DictReader((run_dir / "scalars.csv").open())
         if r["tag"] == "train/success_radius"
     ]
     assert len(radii) == 3 and all(SUCCESS_RADIUS <= r <= 0.03 for r in radii)
-    assert yaml.safe_load((run_dir / "config.yaml").read_text())["train"]["env"]["tolerance_start"] == 0.03
+    assert yaml.safe_load((run_dir / "config.yaml").read_text())["train"]["env"]["aids"] == {
+        "tolerance": {"start": 0.03, "target": 1.0}
+    }

@@ -1,0 +1,223 @@
+"""The env config's ``aids`` section: which training aids a run's training envs carry, with what
+settings (frozen, strict keys, checked on construction). Evaluation envs carry none
+(``EnvConfig.without_training_aids``).
+
+In YAML (an env config, an agent config's ``training_aids`` section, ``roto.make(aids=...)``)::
+
+    aids:
+      replayed_starts: {bank: starts/shadow_preswap.npz, share: 0.5, record_lead: 10}
+      tolerance: {start: 0.025, target: 2}
+      round_swaps: {min_turn: 0.25}
+      turn_shaping: {per_turn: 20}
+
+and as overrides ``env.aids.tolerance.start=0.025``. An aid not named is off. Each setting's
+meaning is on its class; what each aid does is in its module (``roto.envs.aids.<module>``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import typing
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+
+def _number(path: str, value: object, low: float, high: float, what: str) -> None:
+    """Raise ValueError unless ``value`` is a real number in [low, high]."""
+    ok = not isinstance(value, bool) and isinstance(value, int | float) and math.isfinite(value)
+    if not ok or not low <= value <= high:
+        raise ValueError(f"{path} must be {what} in [{low:g}, {high:g}], got {value!r}")
+
+
+def _count(path: str, value: object, low: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < low:
+        raise ValueError(f"{path} must be an integer >= {low}, got {value!r}")
+
+
+def _needs_parameter(path: str, task: Any, parameter: str, what: str) -> None:
+    if parameter not in task.parameters:
+        raise ValueError(f"{path} applies to a task with {what} (baoding); task {task.name!r} has none")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ReplayedStartsSettings:
+    """Episodes start from recorded states (``roto.envs.aids.replayed_starts``).
+
+    Attributes:
+        bank: an ``.npz`` of recorded states (``roto demo --task baoding --preswap_out``: states
+            just before swaps), ``{robot}`` standing for the hand where a config names it.
+        share: the share of episode starts drawn from the bank instead of the task's own.
+        record_lead: 0: off; else the training envs' own states this many control steps before
+            each rise of the task's headline metric (a Baoding swap) join the bank
+            (``roto.envs.aids.event_recorder``).
+        record_capacity: the most states so recorded (the oldest replaced first).
+    """
+
+    bank: str
+    share: float = 0.25
+    record_lead: int = 0
+    record_capacity: int = 1024
+
+    def check(self, path: str, task: Any) -> None:
+        if not isinstance(self.bank, str) or not self.bank:
+            raise ValueError(f"{path}.bank must name an .npz of recorded states, got {self.bank!r}")
+        _number(f"{path}.share", self.share, 0.0, 1.0, "a share")
+        _count(f"{path}.record_lead", self.record_lead, 0)
+        _count(f"{path}.record_capacity", self.record_capacity, 1)
+        if self.record_lead > 0 and self.share == 0.0:
+            raise ValueError(
+                f"{path}.record_lead {self.record_lead} records states for replayed starts, but {path}.share is 0 "
+                "(nothing would replay them); set a share above 0"
+            )
+
+
+@dataclass(frozen=True, kw_only=True)
+class ToleranceSettings:
+    """The task's success radius starts wide and narrows to its own as training episodes succeed
+    (``roto.envs.aids.tolerance``).
+
+    Attributes:
+        start: the radius (m) while no training episode succeeds (at least the task's own).
+        target: the headline metric per training episode (Baoding: rotations) at which the radius
+            is the task's own.
+    """
+
+    start: float
+    target: float = 1.0
+
+    def check(self, path: str, task: Any) -> None:
+        _needs_parameter(path, task, "success_radius", "a success radius")
+        own = task.parameters["success_radius"]
+        _number(f"{path}.start", self.start, own, 1.0, f"a radius (m) no smaller than the task's own {own}")
+        _number(f"{path}.target", self.target, 1e-9, 1e6, "a headline metric per episode")
+
+
+@dataclass(frozen=True, kw_only=True)
+class RoundSwapsSettings:
+    """A swap is paid only after the pair turned ``min_turn`` turns the episode's way round
+    (``roto.envs.aids.round_swaps``).
+
+    Attributes:
+        min_turn: the turns of the line between the balls, since the last paid swap and the same
+            way round as the episode's first, that a paid swap must follow (a pair carried round
+            turns half a turn a swap; one swung out and back is paid once an episode).
+    """
+
+    min_turn: float = 0.25
+
+    def check(self, path: str, task: Any) -> None:
+        _needs_parameter(path, task, "swap_min_turn", "swaps")
+        _number(f"{path}.min_turn", self.min_turn, 0.0, 0.5, "a number of turns")
+
+
+@dataclass(frozen=True, kw_only=True)
+class TurnShapingSettings:
+    """The pair's net turning pays (``roto.envs.aids.turn_shaping``): carrying the balls round
+    pays, a swing out and back does not.
+
+    Attributes:
+        per_turn: the reward per turn the magnitude of the pair's net turning this episode grows,
+            given back as it shrinks (a full turn makes two swaps: 20 pays as much as their swap
+            reward).
+    """
+
+    per_turn: float = 20.0
+
+    def check(self, path: str, task: Any) -> None:
+        _needs_parameter(path, task, "turn_reward", "a ball pair")
+        _number(f"{path}.per_turn", self.per_turn, 0.0, 1000.0, "a reward per turn")
+
+
+@dataclass(frozen=True, kw_only=True)
+class AidsConfig:
+    """The aids section: one entry per aid, None where it is off (the benchmark: all None)."""
+
+    replayed_starts: ReplayedStartsSettings | None = None
+    tolerance: ToleranceSettings | None = None
+    round_swaps: RoundSwapsSettings | None = None
+    turn_shaping: TurnShapingSettings | None = None
+
+    def active(self) -> dict[str, Any]:
+        """{aid: its settings} of the aids that are on, in the section's order."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if getattr(self, f.name) is not None}
+
+    def check(self, task: Any) -> None:
+        """Raise ValueError naming the setting, its value and the valid range, for ``task``."""
+        for name, settings in self.active().items():
+            settings.check(f"aids.{name}", task)
+
+    def to_dict(self) -> dict[str, dict[str, Any]]:
+        """The section as plain data: the aids that are on only."""
+        return {name: dataclasses.asdict(settings) for name, settings in self.active().items()}
+
+
+AID_NAMES = tuple(f.name for f in dataclasses.fields(AidsConfig))
+"""Every aid the section knows, in the order the env applies them."""
+
+
+def parse_aids(data: Mapping[str, Any] | AidsConfig | None, where: str = "aids") -> AidsConfig:
+    """The section from plain data ({aid: {setting: value}}; an aid mapped to None is off).
+
+    Raises:
+        ValueError naming an unknown aid or setting and the valid ones, or a mapping that is not one.
+    """
+    if isinstance(data, AidsConfig):
+        return data
+    if data is None:
+        return AidsConfig()
+    if not isinstance(data, Mapping):
+        raise ValueError(f"{where} must be a mapping of aid names to settings, got {data!r}; aids: {list(AID_NAMES)}")
+    hints = typing.get_type_hints(AidsConfig)
+    kinds = {name: typing.get_args(hints[name])[0] for name in AID_NAMES}  # X of "X | None"
+    built = {}
+    for name, settings in data.items():
+        if name not in kinds:
+            raise ValueError(f"unknown training aid {where}.{name}; valid aids: {list(AID_NAMES)}")
+        if settings is None or isinstance(settings, kinds[name]):
+            built[name] = settings
+            continue
+        if not isinstance(settings, Mapping):
+            raise ValueError(f"{where}.{name} must be a mapping of its settings, got {settings!r}")
+        valid = [f.name for f in dataclasses.fields(kinds[name])]
+        unknown = sorted(set(settings) - set(valid))
+        if unknown:
+            raise ValueError(f"unknown setting(s) {unknown} of {where}.{name}; valid settings: {valid}")
+        try:
+            built[name] = kinds[name](**settings)
+        except TypeError:
+            required = [f.name for f in dataclasses.fields(kinds[name]) if f.default is dataclasses.MISSING]
+            raise ValueError(f"{where}.{name} needs {required}, got {dict(settings)!r}") from None
+    return AidsConfig(**built)
+
+
+LEGACY_FIELDS = {
+    "replay_starts": ("replayed_starts", "bank"),
+    "replay_share": ("replayed_starts", "share"),
+    "replay_record_lead": ("replayed_starts", "record_lead"),
+    "replay_record_capacity": ("replayed_starts", "record_capacity"),
+    "tolerance_start": ("tolerance", "start"),
+    "tolerance_target": ("tolerance", "target"),
+    "swap_min_turn": ("round_swaps", "min_turn"),
+    "turn_reward": ("turn_shaping", "per_turn"),
+}
+"""{env field of run configs and checkpoints of format 1: (aid, setting) of the aids section}."""
+LEGACY_SWITCHES = {"replay_starts": None, "tolerance_start": 0.0, "swap_min_turn": 0.0, "turn_reward": 0.0}
+"""The format-1 field that switched each aid on, at its off value."""
+
+
+def aids_from_legacy_fields(env: Mapping[str, Any]) -> dict[str, Any]:
+    """A stored env config of format 1 (aid settings as flat fields, ``replay_starts`` ...) in
+    today's form (an ``aids`` section holding the aids it switched on)."""
+    env = dict(env)
+    flat = {name: env.pop(name) for name in LEGACY_FIELDS if name in env}
+    on = {LEGACY_FIELDS[name][0] for name, off in LEGACY_SWITCHES.items() if flat.get(name, off) != off}
+    aids: dict[str, dict[str, Any]] = {aid: {} for aid in AID_NAMES if aid in on}
+    for name, value in flat.items():
+        aid, setting = LEGACY_FIELDS[name]
+        if aid in aids:
+            aids[aid][setting] = value
+    if flat:
+        env["aids"] = aids
+    return env
