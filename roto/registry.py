@@ -35,8 +35,8 @@ def make(
     valid = sorted(f.name for f in dataclasses.fields(EnvConfig) if f.name not in ("task", "robot"))
     unknown = sorted(set(options) - set(valid))
     if unknown:
-        moved = {name: "aids=" + repr({LEGACY_FIELDS[name][0]: {LEGACY_FIELDS[name][1]: "..."}}) for name in unknown}
-        hint = [f"{name} is now {new}" for name, new in moved.items() if name in LEGACY_FIELDS]
+        moved = [(name, *LEGACY_FIELDS[name]) for name in unknown if name in LEGACY_FIELDS]
+        hint = [f"{name} is now aids={ {aid: {setting: '...'}} }" for name, aid, setting in moved]
         raise ValueError(f"unknown env option(s) {unknown}; valid options: {valid}" + "".join(f"; {h}" for h in hint))
     config = EnvConfig(
         task=get_task(task).name,
