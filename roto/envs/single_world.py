@@ -37,7 +37,7 @@ def supports_single_world_step(env: RotoEnv) -> bool:
     """Whether ``SingleWorldStep`` can run ``env``: one world on the CPU backend, CPU tensors, binary
     touch, no ``task`` group (and each ball's centre and velocity evenly spaced in qpos and qvel, as
     MuJoCo lays out free joints)."""
-    cpu = env.device.type == "cpu" and isinstance(env.backend, MujocoCpuBackend) and not env.sync_free_step
+    cpu = env.device.type == "cpu" and isinstance(env.backend, MujocoCpuBackend) and not env.checks.sync_free
     balls_as_views = env.indices.ball_pos.start is not None and env.indices.ball_vel.start is not None
     plain = env.config.touch == "binary" and "task" not in env.groups
     return cpu and env.num_envs == 1 and balls_as_views and plain

@@ -43,7 +43,7 @@ def test_share_zero_changes_nothing():
 def test_every_replayed_start_is_the_recorded_state_with_its_latches():
     saved = np.load(BANK)
     env = replay_env(1.0, extra_groups=("task",))
-    starts = env._draw_starts(32)
+    starts = env.starts.draw(32)
     assert starts["replayed"].all()
     bank = env.aid(ReplayedStarts).bank
     for q, v, t, swapped, latched in zip(
@@ -66,7 +66,7 @@ def test_every_replayed_start_is_the_recorded_state_with_its_latches():
 
 def test_a_share_of_starts_is_replayed_the_rest_are_the_task_s_own():
     env = replay_env(0.25)
-    starts = env._draw_starts(400)
+    starts = env.starts.draw(400)
     share = float(starts["replayed"].to(torch.float64).mean())
     assert 0.18 < share < 0.32
     fresh = ~starts["replayed"]
@@ -140,7 +140,7 @@ def test_both_backends_draw_the_same_replayed_starts():
 
     require_warp()
     cpu, warp = replay_env(0.5, seed=4), replay_env(0.5, seed=4, backend="warp")
-    a, b = cpu._draw_starts(16), warp._draw_starts(16)
+    a, b = cpu.starts.draw(16), warp.starts.draw(16)
     assert torch.equal(a["replayed"], b["replayed"]) and a["replayed"].any() and not a["replayed"].all()
     assert torch.equal(a["qpos"], b["qpos"]) and torch.equal(a["qvel"], b["qvel"])
     assert torch.equal(a["frame/tactile"], b["frame/tactile"])

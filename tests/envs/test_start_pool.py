@@ -95,7 +95,7 @@ def test_env_checkpoint_mid_pool_continues_bit_identically():
     cut = None
     for t, a in enumerate(actions):
         first.step(a)
-        if 0 < first._starts.remaining < first._starts.size:  # cut where the pool is part-used
+        if 0 < first.starts.pool.remaining < first.starts.pool.size:  # cut where the pool is part-used
             cut = t + 1
             break
     assert cut is not None, "no reset left the pool part-used within 300 steps"
@@ -109,25 +109,6 @@ def test_env_checkpoint_mid_pool_continues_bit_identically():
     assert all(torch.equal(a, b) for a, b in zip(reference[cut:], resumed, strict=True))
     for env in (whole, first, second):
         env.close()
-
-
-def test_checkpoint_saved_before_pooling_loads_and_draws_fresh_starts():
-    env = make_env("bounce", num_envs=4, seed=3)
-    env.reset()
-    state = env.state_dict()
-    del state["starts"], state["since_check"]  # what envs saved before episode starts were pooled
-    env.step(torch.zeros(4, 20))
-    assert env._starts.remaining == 0  # reset() used all four starts
-    env._starts.take(1)  # leave leftovers that the load must drop
-    env.load_state_dict(state)
-    assert env._starts.remaining == 4  # the leftovers dropped, B starts drawn afresh from the restored generator
-    reference = make_env("bounce", num_envs=4, seed=3)
-    reference.reset()
-    reference._starts.clear()
-    reference._generator.set_state(state["generator"])
-    assert torch.equal(env._starts.take(2)["qpos"], reference._starts.take(2)["qpos"])
-    env.close()
-    reference.close()
 
 
 def test_seeded_reset_repeats_a_fresh_env():

@@ -43,7 +43,7 @@ def deepest_ball_contact(model, qpos) -> float:
 @pytest.mark.parametrize("task", ["bounce", "baoding"])
 def test_no_start_has_the_hand_pressed_into_itself(task, robot):
     env = make_env(task, robot=robot, num_envs=4, seed=3)
-    starts = env._draw_starts(96)
+    starts = env.starts.draw(96)
     depths = [deepest_self_contact(env.model, q.numpy()) for q in starts["qpos"]]
     assert max(depths) == 0.0, f"deepest self-contact {1000 * max(depths):.2f} mm"
     assert not starts["frame/tactile"].any(), "a touch bit is on at a start (the balls start in the air)"
@@ -59,7 +59,7 @@ def test_baoding_balls_start_clear_of_the_hand_and_of_each_other(robot, backend)
     if backend == "warp":
         require_warp()
     env = make_env("baoding", robot=robot, num_envs=4, seed=11, backend=backend)
-    starts = env._draw_starts(256)
+    starts = env.starts.draw(256)
     depths = [deepest_ball_contact(env.model, q.numpy()) for q in starts["qpos"]]
     assert max(depths) <= MAX_BALL_START_PENETRATION, f"deepest ball contact {1000 * max(depths):.2f} mm"
     obs, _ = env.reset()
@@ -71,7 +71,7 @@ def test_both_backends_draw_the_same_baoding_starts():
     require_warp()
     cpu = make_env("baoding", robot="shadow", num_envs=4, seed=5)
     warp = make_env("baoding", robot="shadow", num_envs=4, seed=5, backend="warp")
-    cpu_starts, warp_starts = cpu._draw_starts(64), warp._draw_starts(64)
+    cpu_starts, warp_starts = cpu.starts.draw(64), warp.starts.draw(64)
     assert torch.equal(cpu_starts["qpos"], warp_starts["qpos"])
     assert torch.equal(cpu.task_state.targets, warp.task_state.targets)
     cpu.close()
@@ -81,7 +81,7 @@ def test_both_backends_draw_the_same_baoding_starts():
 def test_the_ball_check_rejects_a_ball_started_in_the_hand():
     """The clearance sensors read a ball placed inside the palm as deep as MuJoCo's contact list does."""
     env = make_env("baoding", robot="shadow", num_envs=4, seed=3)
-    candidates = env._draw_candidates(8)
+    candidates = env.starts.candidates(8)
     assert float(candidates["ball_penetration"].max()) == 0.0  # dropped from above: clear
     qpos = candidates["qpos"].clone()
     rest = torch.tensor(env.robot.baoding_targets[0], dtype=torch.float64)  # where ball a rests on the hand
@@ -99,7 +99,7 @@ def test_the_raw_noise_does_press_fingers_together():
     """Without the rejection the Shadow's joint noise makes fingers interpenetrate (so the test above
     can fail): its candidates include self-contacts deeper than 2 mm."""
     env = make_env("bounce", robot="shadow", num_envs=4, seed=3)
-    candidates = env._draw_candidates(64)
+    candidates = env.starts.candidates(64)
     assert float(candidates["penetration"].max()) > 0.002
     deepest = max(deepest_self_contact(env.model, q.numpy()) for q in candidates["qpos"])
     assert abs(deepest - float(candidates["penetration"].max())) < 1e-9  # the sensor reads the same depth

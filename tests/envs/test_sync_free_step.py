@@ -39,7 +39,7 @@ def rollout(env, steps: int, seed: int = 0, after_step=None) -> tuple[list[torch
 
 
 def sync_free(env, check_every: int):
-    env.sync_free_step, env.check_every = True, check_every
+    env.checks.go_sync_free(check_every)
     return env
 
 
@@ -74,11 +74,11 @@ def test_sync_free_step_with_the_baoding_training_aids_is_bit_identical_to_the_c
     # step draws when a reset runs short, the sync-free step tops its pool up after its reset and
     # every check_every steps, so here the CPU step's pool is topped up then too
     reference = roto.make("baoding", robot="shadow", num_envs=6, seed=1, **RECIPE)
-    reference.check_every = 3  # on the CPU step this sizes only the pool reset() fills
+    reference.checks.every = 3  # on the CPU step this sizes only the pool reset() fills
 
     def top_up(t: int) -> None:
         if t == -1 or (t + 1) % 3 == 0:
-            reference._starts.ensure(3 * reference.num_envs)
+            reference.starts.pool.ensure(3 * reference.num_envs)
 
     candidate = sync_free(roto.make("baoding", robot="shadow", num_envs=6, seed=1, **RECIPE), check_every=3)
     (a, finished), (b, _) = rollout(reference, 150, after_step=top_up), rollout(candidate, 150)

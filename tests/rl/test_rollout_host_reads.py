@@ -30,7 +30,7 @@ def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch,
     )
     settings = TrainSettings(env=env, total_steps=3 * agent.ppo.rollouts * env.num_envs)
     trainer = Trainer(settings, agent, tmp_path / "run", tensorboard=False)
-    trainer.env.sync_free_step, trainer.env.check_every = True, 4  # as on a GPU
+    trainer.env.checks.go_sync_free(4)  # as on a GPU
     assert trainer.env.aid(RecordedEvents) is not None and trainer.env.aid(ToleranceAid) is not None
     collect, collected = trainer._collect_rollout, []
 

@@ -131,7 +131,7 @@ def test_sensors_at_more_states_than_worlds_match_the_cpu_backend_and_change_no_
         env.reset()
         for _ in range(5):
             env.step(env.hold_action().expand(2, -1))
-    starts = envs[0]._draw_starts(5)  # 5 states on 2 worlds: chunks of 2, 2 and 1 on Warp
+    starts = envs[0].starts.draw(5)  # 5 states on 2 worlds: chunks of 2, 2 and 1 on Warp
     qpos, target = starts["qpos"], starts["target"]
     rest = torch.from_numpy(rest_after_drop(envs[0].robot))  # (2, 3) the balls landed in the hand
     for adr, ball in zip(envs[0].layout.ball_qpos, rest, strict=True):

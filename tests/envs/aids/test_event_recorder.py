@@ -164,7 +164,7 @@ def test_an_env_records_its_own_states_lead_steps_before_each_bounce(tmp_path):
     assert int(held) == len(expected) > 10
     for k, qpos in enumerate(expected):
         assert torch.equal(bank.qpos[k], qpos)
-    starts = env._draw_starts(256)
+    starts = env.starts.draw(256)
     replayed = starts["qpos"][starts["replayed"]]
     file_states = env.aid(ReplayedStarts).bank.qpos
     own = [(bank.qpos[: int(held)] == q).all(dim=1).any() for q in replayed]
@@ -187,7 +187,7 @@ def test_a_resumed_env_records_and_draws_as_the_original(tmp_path):
         obs_a, *_ = first.step(action)
         obs_b, *_ = second.step(action)
         assert all(torch.equal(obs_a[k], obs_b[k]) for k in obs_a)
-    assert torch.equal(first._draw_starts(32)["qpos"], second._draw_starts(32)["qpos"])
+    assert torch.equal(first.starts.draw(32)["qpos"], second.starts.draw(32)["qpos"])
 
 
 def test_a_resumed_env_draws_its_starts_when_the_original_does_from_the_states_recorded_by_then(tmp_path):
@@ -201,20 +201,20 @@ def test_a_resumed_env_draws_its_starts_when_the_original_does_from_the_states_r
     for _ in range(400):  # the scripted policy bounces: events to record; drops: resets
         obs, _, terminated, truncated, _ = first.step(policy(obs))
         policy.reset(terminated | truncated)
-        if 0 < first._starts.remaining < WORLDS and first.aid(RecordedEvents).recorder.recorded > 0:
+        if 0 < first.starts.pool.remaining < WORLDS and first.aid(RecordedEvents).recorder.recorded > 0:
             break
-    assert 0 < first._starts.remaining < WORLDS
+    assert 0 < first.starts.pool.remaining < WORLDS
     second = recording_env(own_bank(tmp_path / "other.npz"), share=0.9, seed=7)
     second.load_state_dict(first.state_dict())
     recorded, drew_after_new_states = int(first.aid(RecordedEvents).recorder.recorded), False
     for _ in range(600):
-        left, action = first._starts.remaining, policy(obs)
+        left, action = first.starts.pool.remaining, policy(obs)
         obs, _, terminated, truncated, _ = first.step(action)
         obs_b, *_ = second.step(action)
         assert all(torch.equal(obs[k], obs_b[k]) for k in obs)
         policy.reset(terminated | truncated)
         drew_after_new_states |= (
-            first._starts.remaining > left and int(first.aid(RecordedEvents).recorder.recorded) > recorded
+            first.starts.pool.remaining > left and int(first.aid(RecordedEvents).recorder.recorded) > recorded
         )
     assert drew_after_new_states
     assert torch.equal(
