@@ -41,6 +41,7 @@ from roto.tasks.base import TaskInputs
 
 AidT = TypeVar("AidT", bound=TrainingAid)
 
+
 def backend_for(config: EnvConfig, model: mujoco.MjModel) -> Backend:
     """The physics backend ``config`` names for ``model``; Warp's fixed per-world contact and
     constraint buffers are roto's measured figures for the pair unless the config gives them."""
