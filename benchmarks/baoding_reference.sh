@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The Baoding reference controller on every hand: 16 episodes each (about 15 minutes a hand on
 # 2 threads), its figures and the states just before each swap. A hand whose JSON exists is skipped,
-# so a cut-off run resumes where it stopped.
+# so a cut-off run resumes where it stopped. The banks go where roto ships them (roto/banks/).
 #     bash benchmarks/baoding_reference.sh [episodes]
 set -euo pipefail
 episodes=${1:-16}
@@ -13,6 +13,6 @@ for robot in shadow shadow_lite allegro orca; do
         continue
     fi
     roto demo --task baoding --robot "$robot" --episodes "$episodes" --threads 2 --seed 0 \
-        --preswap_out "$out/${robot}_preswap.npz" > "$out/$robot.json.part"
+        --preswap_out "roto/banks/${robot}_preswap.npz" > "$out/$robot.json.part"
     mv "$out/$robot.json.part" "$out/$robot.json"
 done

@@ -9,10 +9,8 @@ from torch.utils._python_dispatch import TorchDispatchMode
 
 import roto
 
-SHADOW_BANK = str(
-    pathlib.Path(__file__).resolve().parents[1] / "benchmarks/results/baoding_reference/shadow_preswap.npz"
-)
-"""The Shadow reference controller's pre-swap states (a packaged recipe's replay bank)."""
+SHADOW_BANK = str(pathlib.Path(__file__).resolve().parents[1] / "roto/banks/shadow_preswap.npz")
+"""The Shadow reference controller's pre-swap states (a packaged bank, ``shadow_preswap``)."""
 
 BAODING_AIDS = {
     "aids": {

@@ -10,6 +10,7 @@ instead of the task's own starts; evaluation never does.
 from __future__ import annotations
 
 import dataclasses
+import importlib.resources
 import pathlib
 import zipfile
 import zlib
@@ -65,19 +66,47 @@ BANK_BOUND = 1e3
 joint targets of a hand the size of a hand stay far below it; NaN, inf or 1e30 are a broken file."""
 
 
+def packaged_banks() -> dict[str, pathlib.Path]:
+    """{name: file} of the banks roto ships (``roto/banks/<name>.npz``: each hand's reference
+    controller's states before its swaps, ``roto demo --task baoding --preswap_out``)."""
+    folder = importlib.resources.files("roto") / "banks"
+    return {pathlib.Path(str(p)).stem: pathlib.Path(str(p)) for p in folder.iterdir() if p.name.endswith(".npz")}
+
+
+def resolve_bank(bank: str | pathlib.Path) -> pathlib.Path:
+    """The file of ``bank``: a packaged bank's name (no folder, no suffix: ``shadow_preswap``,
+    ``packaged_banks``), or the path of an ``.npz`` (relative: to the current directory).
+
+    Raises:
+        ValueError for a name roto ships no bank under, listing those it ships.
+    """
+    text = str(bank)
+    if "/" in text or "\\" in text or text.endswith(".npz"):
+        return pathlib.Path(text)
+    shipped = packaged_banks()
+    if text not in shipped:
+        raise ValueError(
+            f"aids.replayed_starts.bank {text!r} is no bank roto ships; packaged banks: {sorted(shipped)} "
+            "(or give the path of an .npz)"
+        )
+    return shipped[text]
+
+
 def read_bank(path: str | pathlib.Path) -> dict[str, np.ndarray]:
-    """The arrays of the ``.npz`` bank ``path``, read without pickle.
+    """The arrays of the ``.npz`` bank ``path`` (a packaged bank's name or a file, ``resolve_bank``),
+    read without pickle.
 
     Raises:
         ValueError naming the file and what is wrong with it in one line (missing, a directory,
         not an ``.npz``, truncated or corrupted, or holding object arrays), never loading unsafely.
     """
     where = f"aids.replayed_starts.bank {str(path)!r}"
-    if not pathlib.Path(path).is_file():  # checked here, where it is read: a run's config stays loadable without it
-        what = "is a directory" if pathlib.Path(path).is_dir() else "is not a file"
+    path = resolve_bank(path)
+    if not path.is_file():  # checked here, where it is read: a run's config stays loadable without it
+        what = "is a directory" if path.is_dir() else "is not a file"
         raise ValueError(
             f"{where} {what} (a relative path is read from the current directory, {str(pathlib.Path.cwd())!r}; "
-            "the packaged configs' banks are relative to the repository root)"
+            "a bank roto ships is named without folder or suffix, e.g. 'shadow_preswap')"
         )
     with open(path, "rb") as file:
         head = file.read(6)

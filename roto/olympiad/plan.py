@@ -190,7 +190,7 @@ def _variant(name: str, spec: Any, where: str) -> Variant:
         _check_keys(entry or {}, VARIANT_KEYS, f"{where}, task {task!r}")
         entry = entry or {}
         overrides = tuple(entry.get("overrides") or ())
-        split_overrides(list(overrides))  # env keys checked here; their values with the cells' envs
+        split_overrides([o.replace(ROBOT_FIELD, "robot") for o in overrides])  # env keys now, values per cell
         roto_agent = entry.get("roto_agent")
         if roto_agent is not None and roto_agent not in ROTO_AGENTS:
             raise ValueError(f"{where}, task {task!r}: unknown roto_agent {roto_agent!r}; valid: {list(ROTO_AGENTS)}")

@@ -3,6 +3,7 @@ import pathlib
 
 import pytest
 
+from roto.envs.replay_starts import packaged_banks
 from roto.olympiad.plan import Cell, load_plan, packaged_plans
 from roto.rl.config import load_agent_config
 
@@ -161,7 +162,7 @@ def test_robot_in_an_override_becomes_each_cells_hand():
     cells = (("shadow", "task_critic_replay", 0.25), ("orca", "task_critic_more_aids_low_noise", 0.5))
     for robot, variant, share in cells:
         spec = cell_spec(plan, Cell("baoding", robot, "blind", variant, 1))
-        assert spec.env.aids.replayed_starts.bank == f"benchmarks/results/baoding_reference/{robot}_preswap.npz"
+        assert spec.env.aids.replayed_starts.bank == f"{robot}_preswap"
         assert spec.env.aids.replayed_starts.share == share and spec.agent.ppo.epochs == 4 and spec.env.threads == 1
     assert {(c.robot, c.variant) for c in plan.cells} == {
         ("shadow", "task_critic_replay"),
@@ -172,9 +173,7 @@ def test_robot_in_an_override_becomes_each_cells_hand():
     more_aids = load_plan("baoding_v1_more_aids")
     same = cell_spec(more_aids, next(c for c in more_aids.cells if c.variant == "all_three"))
     assert lite.differences(same) == {}  # the all_three run continues as this plan's cell
-    assert all(
-        pathlib.Path(f"benchmarks/results/baoding_reference/{c.robot}_preswap.npz").is_file() for c in plan.cells
-    )
+    assert all(f"{c.robot}_preswap" in packaged_banks() for c in plan.cells)
 
 
 def test_robot_in_an_agent_config_names_a_config_per_hand_and_a_missing_one_is_refused(tmp_path):
@@ -206,8 +205,7 @@ def test_the_more_aids_plan_adds_each_aid_to_the_recipe_for_shadow_lite():
     specs = {c.variant: cell_spec(plan, c) for c in plan.cells if c.robot == "shadow_lite"}
     assert len(specs) == 4
     assert all(
-        s.env.aids.replayed_starts.bank.endswith("shadow_lite_preswap.npz") and s.agent.ppo.epochs == 4
-        for s in specs.values()
+        s.env.aids.replayed_starts.bank == "shadow_lite_preswap" and s.agent.ppo.epochs == 4 for s in specs.values()
     )
     tolerance, record = specs["tolerance"].env.aids, specs["record"].env.aids
     assert tolerance.tolerance.start == 0.025 and tolerance.replayed_starts.record_lead == 0
@@ -234,7 +232,7 @@ def test_the_more_aids_probe_of_a_hand_trains_as_its_20m_cell_does(robot, probe_
 
     probe = cell_spec(load_plan("baoding_v1_more_aids"), Cell("baoding", robot, "blind", probe_variant, 0))
     cell = cell_spec(load_plan("baoding_v1_cpu"), Cell("baoding", robot, "blind", cell_variant, 0))
-    assert probe.differences(cell) == {} and probe.env.aids.replayed_starts.bank.endswith(f"{robot}_preswap.npz")
+    assert probe.differences(cell) == {} and probe.env.aids.replayed_starts.bank == f"{robot}_preswap"
     assert (probe.steps, cell.steps) == (5_000_000, 20_000_000)
 
 
@@ -268,7 +266,7 @@ def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(plan_nam
     cell = cell_spec(plan, Cell("baoding", robot, "blind", variant, 0))
     config = f"baoding_cpu_{robot}"
     packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=1)
-    assert packaged.differences(cell) == {} and packaged.env.aids.replayed_starts.bank.endswith(f"{robot}_preswap.npz")
+    assert packaged.differences(cell) == {} and packaged.env.aids.replayed_starts.bank == f"{robot}_preswap"
 
 
 def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_to_its_own():
@@ -296,7 +294,7 @@ def test_each_ablation_changes_exactly_its_part_of_the_baoding_recipe():
     assert {c.seed for c in plan.cells} == {1} and {c.robot for c in plan.cells} == {"shadow"}
     recipe = cell_spec(plan, Cell("baoding", "shadow", "blind", "recipe", 1))
     assert recipe.differences(cell_spec(main, Cell("baoding", "shadow", "blind", "task_critic_more_aids", 1))) == {}
-    bank = "benchmarks/results/baoding_reference/shadow_preswap.npz"
+    bank = "shadow_preswap"
     replayed = {"bank": bank, "share": 0.5, "record_lead": 10, "record_capacity": 1024}
     expected = {
         "recipe": {},
@@ -329,8 +327,7 @@ def test_the_low_noise_plan_trains_orcas_recipe_on_other_hands_as_the_ablation_d
     for cell in plan.cells:
         spec = cell_spec(plan, cell)
         assert (
-            spec.env.aids.replayed_starts.bank.endswith(f"{cell.robot}_preswap.npz")
-            and spec.agent.network.max_log_std == -1.386
+            spec.env.aids.replayed_starts.bank == f"{cell.robot}_preswap" and spec.agent.network.max_log_std == -1.386
         )
 
 
@@ -340,9 +337,9 @@ def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_st
     plan = load_plan("baoding_v1_more_aids")
     cycle = cell_spec(plan, Cell("baoding", "allegro", "blind", "cycle_low_noise", 0))
     low = cell_spec(plan, Cell("baoding", "allegro", "blind", "all_three_low_noise", 0))
-    bank = "benchmarks/results/baoding_reference/allegro_cycle.npz"
+    bank = "allegro_cycle"
     assert cycle.differences(low) == {"env.aids.replayed_starts.bank": (bank, bank.replace("cycle", "preswap"))}
-    assert pathlib.Path(bank).is_file()
+    assert bank in packaged_banks()
 
 
 def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
@@ -355,7 +352,7 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
     recipe = build_run_spec("baoding", "orca", "blind", "baoding_cpu_orca", [], plan.steps, num_envs=128, threads=1)
     bank, round_bank = (
         recipe.env.aids.replayed_starts.bank,
-        "benchmarks/results/baoding_reference/orca_round_preswap.npz",
+        "orca_round_preswap",
     )
     expected = {
         "round_swaps": {"env.aids.round_swaps": ({"min_turn": 0.25}, None)},
@@ -374,7 +371,7 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
     for cell in plan.cells:
         seed = {"env.seed": (cell.seed, 0)} if cell.seed else {}
         assert cell_spec(plan, cell).differences(recipe) == {**expected[cell.variant], **seed}
-    assert pathlib.Path(round_bank).is_file()
+    assert round_bank in packaged_banks()
     long = load_plan("baoding_v1_orca_round")  # the round cells' continuation: the same runs, longer
     assert long.steps == 20_000_000
     assert [c.name for c in long.cells] == [c.name for c in plan.cells if c.variant == "round_bank_round_swaps"]
@@ -393,13 +390,13 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
     plan = load_plan("baoding_v1_shadow_round")
     assert [c.name for c in plan.cells] == ["baoding-shadow-blind-round-seed3"] and plan.steps == 5_000_000
     recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu_shadow", [], plan.steps, num_envs=128, threads=1)
-    round_bank = "benchmarks/results/baoding_reference/shadow_round_preswap.npz"
+    round_bank = "shadow_round_preswap"
     assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
         "env.aids.replayed_starts.bank": (round_bank, recipe.env.aids.replayed_starts.bank),
         "env.aids.round_swaps": ({"min_turn": 0.25}, None),
         "env.seed": (3, 0),
     }  # fmt: skip
-    assert pathlib.Path(round_bank).is_file()
+    assert round_bank in packaged_banks()
 
 
 def test_the_busiest_worker_and_a_running_cells_rate():

@@ -20,7 +20,7 @@ from roto.reference.baoding_cost import BaodingCostWeights
 from roto.reference.predictive_sampling import PredictiveSampling, SamplingConfig
 from roto.registry import make
 
-PRESWAP = pathlib.Path(__file__).resolve().parents[2] / "benchmarks/results/baoding_reference/shadow_preswap.npz"
+PRESWAP = pathlib.Path(__file__).resolve().parents[2] / "roto/banks/shadow_preswap.npz"
 
 
 def controller_for(env, seed: int = 0) -> BaodingReference:

@@ -2,8 +2,10 @@ import pathlib
 
 import pytest
 
+from roto.rl.config import packaged_configs
 from roto.rl.run_spec import build_run_spec
 from roto.rl.runner import Trainer
+from roto.robots import ROBOTS
 from tests.conftest import SHADOW_BANK
 from tests.rl.toy_env import ToyEnv
 
@@ -96,3 +98,23 @@ def test_a_run_that_died_before_its_first_checkpoint_starts_over_without_its_old
     again.train(progress=False)
     assert [r["update"] for r in read_evaluations(run)] == [1, 2]
     assert [r["return_mean"] for r in read_evaluations(run)] == [r["return_mean"] for r in first]  # same seed
+
+
+def hand_of(config_name: str) -> str:
+    """The hand a packaged config is named for (``baoding_cpu_orca`` -> orca), else the Shadow."""
+    named = [robot for robot in ROBOTS if config_name.endswith(f"_{robot}") or f"_{robot}_" in config_name]
+    return max(named, key=len) if named else "shadow"
+
+
+@pytest.mark.parametrize("name", sorted(packaged_configs()))
+def test_every_packaged_config_trains_one_update_from_any_directory(name, tmp_path, monkeypatch):
+    """Everything a packaged config needs (its base configs, its banks) ships with roto: it trains
+    from a folder that is not the repository."""
+    monkeypatch.chdir(tmp_path)
+    task = "baoding" if name.startswith("baoding") else "bounce"
+    tiny = ["env.episode_steps=8", "ppo.rollouts=8", "run.num_eval_envs=1", "run.eval_every=100"]
+    tiny += ["ppo.cuda_graph=false"] if name.endswith("_gpu") else []  # its update graph needs a CUDA device
+    spec = build_run_spec(task, hand_of(name), "blind", name, tiny, 2 * 8, num_envs=2)
+    with Trainer.open(tmp_path / "run", spec, tensorboard=False) as trainer:
+        trainer.train(progress=False)
+        assert trainer.update == 1

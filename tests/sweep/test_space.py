@@ -26,7 +26,7 @@ def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load
     orca = EnvConfig(task="bounce", robot="orca", num_envs=8)
     noise = load_space("cpu_quickstart_noise", orca, "bounce_cpu_quickstart")
     assert noise.parameters[:7] == quick.parameters and noise.parameters[7].key == "network.init_log_std"
-    bank = "benchmarks/results/baoding_reference/shadow_preswap.npz"
+    bank = "shadow_preswap"
     baoding = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu",
                          [f"env.aids.replayed_starts.bank={bank}", "env.aids.replayed_starts.share=0.25"])  # fmt: skip
     assert [p.key for p in baoding.parameters] == [

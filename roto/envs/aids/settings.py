@@ -203,19 +203,24 @@ LEGACY_FIELDS = {
     "turn_reward": ("turn_shaping", "per_turn"),
 }
 """{env field of run configs and checkpoints of format 1: (aid, setting) of the aids section}."""
+LEGACY_BANK_FOLDER = "benchmarks/results/baoding_reference/"
+"""Where format 1's configs named the banks roto now ships (``roto/banks/<name>.npz``)."""
 LEGACY_SWITCHES = {"replay_starts": None, "tolerance_start": 0.0, "swap_min_turn": 0.0, "turn_reward": 0.0}
 """The format-1 field that switched each aid on, at its off value."""
 
 
 def aids_from_legacy_fields(env: Mapping[str, Any]) -> dict[str, Any]:
     """A stored env config of format 1 (aid settings as flat fields, ``replay_starts`` ...) in
-    today's form (an ``aids`` section holding the aids it switched on)."""
+    today's form (an ``aids`` section holding the aids it switched on; a bank roto now ships by
+    its name)."""
     env = dict(env)
     flat = {name: env.pop(name) for name in LEGACY_FIELDS if name in env}
     on = {LEGACY_FIELDS[name][0] for name, off in LEGACY_SWITCHES.items() if flat.get(name, off) != off}
     aids: dict[str, dict[str, Any]] = {aid: {} for aid in AID_NAMES if aid in on}
     for name, value in flat.items():
         aid, setting = LEGACY_FIELDS[name]
+        if name == "replay_starts" and str(value).startswith(LEGACY_BANK_FOLDER):  # a bank roto now ships
+            value = str(value).removeprefix(LEGACY_BANK_FOLDER).removesuffix(".npz")
         if aid in aids:
             aids[aid][setting] = value
     if flat:
