@@ -275,6 +275,8 @@ def resolve_config_path(task: str, path: str | pathlib.Path | None) -> pathlib.P
     """The YAML file a ``--agent_cfg`` value means: a file, a packaged config's name, or (None) the task's default."""
     shipped = packaged_configs()
     if path is None:
+        if task not in shipped:
+            raise ValueError(f"task {task!r} has no packaged default agent config (roto/configs/{task}.yaml); name one")
         return shipped[task]
     source = pathlib.Path(path)
     if source.is_file():
