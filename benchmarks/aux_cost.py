@@ -20,7 +20,8 @@ import torch
 from roto.envs.config import EnvConfig
 from roto.rl.config import load_agent_config
 from roto.rl.run_dir import read_scalars
-from roto.rl.runner import Trainer, TrainSettings
+from roto.rl.run_spec import RunSpec
+from roto.rl.runner import Trainer
 
 FD = "weight: 0.0021, lr: 1.5e-5, seq_length: 8"
 VARIANTS = {
@@ -39,7 +40,7 @@ def measure(overrides: list[str], args: argparse.Namespace, run_dir: str) -> dic
     env = EnvConfig(task="bounce", robot="shadow", num_envs=args.num_envs, threads=args.threads, seed=0)
     agent = load_agent_config("bounce", "bounce_cpu", [*overrides, "run.eval_every=100000"])
     steps = agent.ppo.rollouts * args.num_envs * args.updates
-    trainer = Trainer(TrainSettings(env=env, total_steps=steps), agent, run_dir, tensorboard=False)
+    trainer = Trainer(RunSpec(env=env, agent=agent, steps=steps), run_dir, tensorboard=False)
     trainer.train(progress=False)
     trainer.env.close()
     trainer.evaluator.env.close()

@@ -34,8 +34,8 @@ def main() -> None:
     figures = {}
     for path in args.checkpoints:
         checkpoint = checkpoint_of(path)
-        model, settings, _ = load_policy(checkpoint)
-        figures[str(checkpoint)] = rhythm(*record_rhythm(model, settings, envs=args.envs, seed=args.seed))
+        model, spec = load_policy(checkpoint)
+        figures[str(checkpoint)] = rhythm(*record_rhythm(model, spec, envs=args.envs, seed=args.seed))
         print(checkpoint, " ".join(f"{name} {value:.2f}" for name, value in figures[str(checkpoint)].items()))
     if args.json:
         pathlib.Path(args.json).write_text(json.dumps(figures, indent=2) + "\n")

@@ -9,10 +9,12 @@ from __future__ import annotations
 from types import MappingProxyType
 
 FORMAT_KEY = "format"
-FORMATS = MappingProxyType({"checkpoint": 2, "run config": 2, "cell summary": 1, "bank": 1})
+FORMATS = MappingProxyType({"checkpoint": 3, "run config": 3, "cell summary": 1, "bank": 1})
 """{kind of file: the format this roto writes (and the newest it reads)}. Checkpoints and run
-configs 2: the env's training aids in one ``aids`` section (format 1 held them as flat env fields;
-``roto.envs.aids.settings.aids_from_legacy_fields`` reads them)."""
+configs: 2, the env's training aids in one ``aids`` section (format 1 held them as flat env fields;
+``roto.envs.aids.settings.aids_from_legacy_fields`` reads them); 3, the run's ``RunSpec`` (env,
+agent, steps) where formats 1 and 2 had a ``train`` section (env, total_steps) beside the agent
+(``roto.rl.run_spec.spec_data`` reads them)."""
 
 
 def format_stamp(kind: str) -> dict[str, int]:

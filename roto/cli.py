@@ -66,9 +66,9 @@ def _cmd_train(args: argparse.Namespace) -> int:
     import torch
 
     from roto.eval.plots import plot_learning_curve
+    from roto.rl.run_config import CONFIG_NAME
     from roto.rl.run_spec import DEFAULT_STEPS, build_run_spec
     from roto.rl.runner import Trainer
-    from roto.rl.settings import CONFIG_NAME
 
     if isinstance(args.torch_threads, bool) or args.torch_threads < 1:
         raise ValueError(f"--torch_threads must be an integer >= 1, got {args.torch_threads}")
@@ -112,7 +112,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
     plot_learning_curve(trainer.run_dir)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
     summary.update({k.removeprefix("eval/"): v for k, v in last.items()})
-    summary["settings"] = trainer.settings.to_dict()
+    summary["spec"] = trainer.spec.to_dict()
     print(json.dumps(summary))
     return 0
 
@@ -152,9 +152,9 @@ def _cmd_eval(args: argparse.Namespace) -> int:
 
     out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
     check_output_path(out, "--out", example="eval.json")  # before the evaluation, which would be lost
-    model, settings, _ = load_policy(args.checkpoint)
-    result = evaluate(model, settings, episodes=args.episodes, seed=args.seed)
-    result = {"checkpoint": str(args.checkpoint), "task": settings.env.task, "robot": settings.env.robot, **result}
+    model, spec = load_policy(args.checkpoint)
+    result = evaluate(model, spec, episodes=args.episodes, seed=args.seed)
+    result = {"checkpoint": str(args.checkpoint), "task": spec.env.task, "robot": spec.env.robot, **result}
     write_text_atomic(make_parents(out), json.dumps(result, indent=1))
     print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))
     print(f"wrote {out}", file=sys.stderr)
@@ -166,8 +166,8 @@ def _cmd_play(args: argparse.Namespace) -> int:
     from roto.rl.run_dir import load_policy
 
     check_output_path(args.video, "--video", example="play.mp4")  # missing folders are made when it is written
-    model, settings, _ = load_policy(args.checkpoint)
-    result = record_video(model, settings, args.video, steps=args.video_length, seed=args.seed)
+    model, spec = load_policy(args.checkpoint)
+    result = record_video(model, spec, args.video, steps=args.video_length, seed=args.seed)
     print(json.dumps({"video": str(args.video), **result}))
     return 0
 

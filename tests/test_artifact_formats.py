@@ -15,7 +15,8 @@ from roto.envs.config import EnvConfig
 from roto.olympiad.results import check_summary
 from roto.rl.checkpoints import load_checkpoint, save_checkpoint
 from roto.rl.config import AgentConfig
-from roto.rl.settings import TrainSettings, read_run_config, write_run_config
+from roto.rl.run_config import read_run_config, write_run_config
+from roto.rl.run_spec import RunSpec
 from tests.conftest import SHADOW_BANK
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -28,7 +29,7 @@ def newer_checkpoint(path):
 
 
 def newer_run_config(path):
-    write_run_config(path, TrainSettings(env=EnvConfig(task="bounce"), total_steps=16), AgentConfig())
+    write_run_config(path, RunSpec(env=EnvConfig(task="bounce"), agent=AgentConfig(), steps=16))
     config = yaml.safe_load((path / "config.yaml").read_text())
     assert config["format"] == FORMATS["run config"]  # what roto writes now
     (path / "config.yaml").write_text(yaml.safe_dump({**config, "format": 99}))
@@ -75,10 +76,10 @@ SHADOW_BANK_IN_REPO = "shadow_preswap"  # format 1 named it by its old path; rot
 def test_a_format_1_run_config_with_flat_aid_fields_reads_into_the_aids_section(tmp_path):
     config = yaml.safe_load((pathlib.Path(__file__).parent / "data" / "run_config_format1.yaml").read_text())
     (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
-    settings, _ = read_run_config(tmp_path)
+    settings = read_run_config(tmp_path)
     aids = settings.env.aids
     replayed = aids.replayed_starts
     assert (replayed.bank, replayed.share, replayed.record_lead) == (SHADOW_BANK_IN_REPO, 0.5, 10)
     assert (aids.tolerance.start, aids.tolerance.target) == (0.025, 2) and aids.round_swaps is None  # 0.0: off
     assert aids.turn_shaping.per_turn == 20 and settings.to_dict()["env"]["aids"] == aids.to_dict()
-    assert TrainSettings.from_dict(settings.to_dict()) == settings
+    assert RunSpec.from_dict(settings.to_dict()) == settings and settings.steps == 5_000_000

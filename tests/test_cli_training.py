@@ -7,6 +7,7 @@ import imageio.v2 as imageio
 import pytest
 import yaml
 
+from roto.artifact_formats import FORMATS
 from roto.cli import main
 from roto.rl.checkpoints import load_checkpoint
 from roto.rl.run_dir import load_policy
@@ -51,8 +52,10 @@ def trained_run(tmp_path_factory):
 
 def test_train_writes_config_checkpoints_csv_and_events(trained_run, capsys):
     config = yaml.safe_load((trained_run / "config.yaml").read_text())
-    assert config["train"]["env"]["action_smoothing"] == 0.9 and config["agent"]["ppo"]["rollouts"] == 4
-    assert config["format"] == 1 and load_checkpoint(trained_run / "checkpoints" / "latest.pt")["format"] == 1
+    assert config["env"]["action_smoothing"] == 0.9 and config["agent"]["ppo"]["rollouts"] == 4
+    latest = load_checkpoint(trained_run / "checkpoints" / "latest.pt")
+    assert config["format"] == FORMATS["run config"] and latest["format"] == FORMATS["checkpoint"]
+    assert config["steps"] == latest["spec"]["steps"] and latest["spec"]["env"] == config["env"]
     ckpts = trained_run / "checkpoints"
     assert (ckpts / "latest.pt").is_file() and (ckpts / "agent_3.pt").is_file()
     csv_text = (trained_run / "scalars.csv").read_text()
@@ -89,7 +92,7 @@ def test_eval_reads_a_gpu_trained_policy_only_checkpoint_as_gpu_suite_writes_it(
     state = torch.load(full, weights_only=True)
     policy = tmp_path / "policy_latest.pt"
     gpu = {k: state[k] for k in POLICY_KEYS}  # as benchmarks/gpu_suite.sh keeps it: no env state
-    gpu["train"]["env"].update(backend="warp", device="cuda")  # trained on a GPU; evaluated on this CPU
+    gpu["spec"]["env"].update(backend="warp", device="cuda")  # trained on a GPU; evaluated on this CPU
     torch.save(gpu, policy)
     results = []
     for checkpoint in (full, policy):
@@ -172,7 +175,7 @@ def test_a_force_touch_run_keeps_its_touch_through_eval(tmp_path, capsys):
     assert "touch: force" in (run_dir / "config.yaml").read_text()
     ckpt = run_dir / "checkpoints" / "best.pt"
     assert main(["eval", "--checkpoint", str(ckpt), "--episodes", "2", "--out", str(tmp_path / "e.json")]) == 0
-    _, settings, _ = load_policy(ckpt)
+    _, settings = load_policy(ckpt)
     assert settings.env.touch == "force"
     trainer = Trainer.resume(run_dir)  # the learner the run trains with decodes force touch with MSE
     (reconstruction,) = trainer.alg.aux_losses
@@ -253,7 +256,7 @@ def relabelled(checkpoint, path, **env):
     import torch
 
     state = torch.load(checkpoint, weights_only=True)
-    state["train"]["env"].update(env)
+    state["spec"]["env"].update(env)
     path.parent.mkdir(parents=True, exist_ok=True)
     torch.save(state, path)
     return str(path)
@@ -340,5 +343,5 @@ def test_task_and_robot_names_in_any_case_train_into_the_canonical_run_folder(tm
     args = ["train", "--task", "Bounce", "--robot", "Shadow-Lite", "--num_envs", "2", "--steps", "8", "--no_progress"]
     assert main([*args, *TINY]) == 0
     (run,) = (tmp_path / "runs" / "bounce_shadow_lite_blind").iterdir()
-    settings = yaml.safe_load((run / "config.yaml").read_text())["train"]["env"]
+    settings = yaml.safe_load((run / "config.yaml").read_text())["env"]
     assert (settings["task"], settings["robot"]) == ("bounce", "shadow_lite")

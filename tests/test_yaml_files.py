@@ -6,7 +6,7 @@ from roto.cli import main
 from roto.envs.config import EnvConfig
 from roto.olympiad.plan import load_plan
 from roto.rl.config import load_agent_config, parse_override
-from roto.rl.settings import read_run_config
+from roto.rl.run_config import read_run_config
 from roto.sweep.space import load_space
 from roto.yaml_files import read_yaml
 

@@ -18,7 +18,7 @@ from roto.envs.ball_paths import BALL_GROUP, with_ball_state
 from roto.envs.observations import ball_positions
 from roto.envs.roto_env import RotoEnv
 from roto.rl.networks import ActorCritic
-from roto.rl.settings import TrainSettings
+from roto.rl.run_spec import RunSpec
 from roto.rl.torch_threads import single_torch_thread
 from roto.tasks.bounce import MIN_FLIGHT_STEPS
 
@@ -83,16 +83,16 @@ def rhythm(contact: np.ndarray, bounce: np.ndarray, height: np.ndarray, lengths:
 
 @torch.no_grad()
 def record_rhythm(
-    model: ActorCritic, settings: TrainSettings, envs: int = 16, seed: int = 1_000_000
+    model: ActorCritic, spec: RunSpec, envs: int = 16, seed: int = 1_000_000
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(contact, bounce, height), each (T, B), and lengths (B,) of the first episode of every env
-    under ``model``'s deterministic policy on Bounce (CPU backend, ``settings``' env): ``rhythm``'s
+    under ``model``'s deterministic policy on Bounce (CPU backend, ``spec``'s env): ``rhythm``'s
     inputs. An episode's last step (where the env starts the next one) is left out of its length."""
-    if settings.env.task != "bounce":
-        raise ValueError(f"the bounce rhythm needs a Bounce run (task 'bounce'), got task {settings.env.task!r}")
+    if spec.env.task != "bounce":
+        raise ValueError(f"the bounce rhythm needs a Bounce run (task 'bounce'), got task {spec.env.task!r}")
     if envs < 1:
         raise ValueError(f"the bounce rhythm needs envs >= 1, got {envs}")
-    env = RotoEnv(with_ball_state(settings.cpu_env_config(num_envs=envs, seed=seed)))
+    env = RotoEnv(with_ball_state(spec.cpu_env_config(num_envs=envs, seed=seed)))
     obs, _ = env.reset(seed=seed)
     steps = env.config.episode_steps
     contact, bounce, height = [], [], []

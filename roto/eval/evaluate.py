@@ -13,7 +13,7 @@ from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import check_policy_fits
 from roto.rl.networks import ActorCritic
-from roto.rl.settings import TrainSettings
+from roto.rl.run_spec import RunSpec
 from roto.rl.torch_threads import single_torch_thread
 
 MAX_PARALLEL_ENVS = 128
@@ -22,7 +22,7 @@ MAX_PARALLEL_ENVS = 128
 @torch.no_grad()
 def evaluate(
     model: ActorCritic,
-    settings: TrainSettings,
+    spec: RunSpec,
     episodes: int = 100,
     seed: int = 1_000_000,
     env_factory: Callable[[EnvConfig], Any] = RotoEnv,
@@ -37,7 +37,7 @@ def evaluate(
     per_episode: dict[str, list[float]] = {}
     for batch in range(math.ceil(episodes / MAX_PARALLEL_ENVS)):
         n = min(MAX_PARALLEL_ENVS, episodes - batch * MAX_PARALLEL_ENVS)
-        env = env_factory(for_path_metrics(settings.cpu_env_config(num_envs=n, seed=seed + batch)))
+        env = env_factory(for_path_metrics(spec.cpu_env_config(num_envs=n, seed=seed + batch)))
         check_policy_fits(model, env)
         obs, _ = env.reset(seed=seed + batch)
         with single_torch_thread(env.device):

@@ -18,7 +18,7 @@ from roto.envs.observations import FORCE_SCALE, tactile_frame
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import check_policy_fits
 from roto.rl.networks import ActorCritic
-from roto.rl.settings import TrainSettings
+from roto.rl.run_spec import RunSpec
 from roto.sim.scene import TAXEL_SITE_GROUP
 
 TOUCH_RGBA = np.array([0.0, 0.85, 1.0, 1.0], dtype=np.float32)
@@ -131,7 +131,7 @@ class TactileFrameRenderer:
 @torch.no_grad()
 def record_video(
     model: ActorCritic,
-    settings: TrainSettings,
+    spec: RunSpec,
     path: str | pathlib.Path,
     steps: int = 600,
     seed: int = 0,
@@ -147,7 +147,7 @@ def record_video(
     if steps < 1:
         raise ValueError(f"video length must be >= 1 step, got {steps}")
     path = check_output_path(path, "video path", example="play.mp4")
-    env = RotoEnv(settings.cpu_env_config(num_envs=1, seed=seed))
+    env = RotoEnv(spec.cpu_env_config(num_envs=1, seed=seed))
     check_policy_fits(model, env)
     renderer = TactileFrameRenderer(env, width, height)
     obs_dict, _ = env.reset(seed=seed)

@@ -127,8 +127,8 @@ def run_cell(
         "best_update": max(records, key=lambda r: r["return_mean"])["update"],
         "evaluations": [{k: v for k, v in r.items() if k != "per_episode"} for r in records],
         "training": training_curve(read_scalars(run_dir), [r["env_steps"] for r in records]),
-        "final": evaluate(final, trainer.settings, plan.eval_episodes, env_factory=env_factory),
-        "best": evaluate(best, trainer.settings, plan.eval_episodes, env_factory=env_factory),
+        "final": evaluate(final, trainer.spec, plan.eval_episodes, env_factory=env_factory),
+        "best": evaluate(best, trainer.spec, plan.eval_episodes, env_factory=env_factory),
     }
     results.mkdir(parents=True, exist_ok=True)
     write_text_atomic(summary_path(results, cell), json.dumps(summary, indent=1))

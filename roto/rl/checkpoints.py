@@ -43,8 +43,9 @@ def load_checkpoint(path: str | pathlib.Path, device: torch.device | str = "cpu"
         state = torch.load(path, weights_only=True, map_location=device)
     except Exception as error:  # a foreign file fails in the unpickler in many ways (KeyError, EOFError ...)
         raise ValueError(f"{where}: {_load_failure(error)}") from None
-    if not isinstance(state, dict) or not {"model", "train", "agent"} <= state.keys():
-        raise ValueError(f"{str(path)!r} is not a roto checkpoint: it lacks the model, train and agent entries")
+    run_entries = {"spec"} if isinstance(state, dict) and "spec" in state else {"train", "agent"}  # formats 1, 2
+    if not isinstance(state, dict) or not {"model", *run_entries} <= state.keys():
+        raise ValueError(f"{str(path)!r} is not a roto checkpoint: it lacks the model and spec entries")
     check_format("checkpoint", state.get(FORMAT_KEY), f"checkpoint {str(path)!r}")
     return state
 

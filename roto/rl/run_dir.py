@@ -1,6 +1,6 @@
 """A run directory's layout and its readers, in one place.
 
-``<run_dir>/config.yaml`` (``roto.rl.settings``), ``scalars.csv``, ``evaluations.jsonl``,
+``<run_dir>/config.yaml`` (``roto.rl.run_config``), ``scalars.csv``, ``evaluations.jsonl``,
 ``tensorboard/`` and ``checkpoints/``: ``latest.pt`` (everything a resume needs), ``best.pt`` and
 the numbered copies ``agent_<update>.pt`` (the policy only, ``POLICY_KEYS``). ``load_policy``
 reads any of them without building an env (checking its labels against its run's ``config.yaml``);
@@ -17,14 +17,14 @@ from typing import Any
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import build_model, extra_groups, stacked_sizes
 from roto.rl.checkpoints import load_checkpoint
-from roto.rl.config import AgentConfig, from_dict
 from roto.rl.evaluation import read_evaluations
 from roto.rl.logger import CSV_NAME
 from roto.rl.networks import ActorCritic
-from roto.rl.settings import TrainSettings, read_run_config
+from roto.rl.run_config import read_run_config
+from roto.rl.run_spec import RunSpec
 
 CHECKPOINT_DIR = "checkpoints"
-POLICY_KEYS = ("format", "model", "train", "agent", "obs_sizes", "num_actions", "update", "env_steps")
+POLICY_KEYS = ("format", "model", "spec", "obs_sizes", "num_actions", "update", "env_steps")
 POLICY_KEYS += ("best_eval_return", "best_eval", "last_eval")
 """What a policy-only checkpoint holds: enough for ``load_policy``, ``roto eval`` and ``roto play``."""
 
@@ -50,36 +50,32 @@ def first_missing(path: pathlib.Path) -> pathlib.Path | None:
     return missing
 
 
-def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, TrainSettings, AgentConfig]:
-    """The policy stored in a checkpoint (on the CPU, in eval mode), with the run's settings."""
+def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, RunSpec]:
+    """The policy stored in a checkpoint (on the CPU, in eval mode), with the run's spec."""
     state = load_checkpoint(checkpoint)
-    settings = TrainSettings.from_dict(state["train"])
-    agent = from_dict(AgentConfig, state["agent"]).validate()
-    obs_mode = settings.env.obs_mode
-    _check_run_labels(pathlib.Path(checkpoint), settings)
+    spec = RunSpec.from_dict(state.get("spec") or state)  # formats 1 and 2: "train" and "agent"
+    _check_run_labels(pathlib.Path(checkpoint), spec)
     if "obs_sizes" in state:
         sizes, num_actions = {k: int(v) for k, v in state["obs_sizes"].items()}, int(state["num_actions"])
     else:  # written before checkpoints carried their sizes: an env tells them
-        env = RotoEnv(settings.cpu_env_config(num_envs=1, extra_groups=extra_groups(agent, obs_mode)))
+        env = RotoEnv(spec.cpu_env_config(num_envs=1, extra_groups=extra_groups(spec.agent, spec.env.obs_mode)))
         sizes, num_actions = stacked_sizes(env), env.num_actions
         env.close()
-    model = build_model(sizes, num_actions, agent, obs_mode)
+    model = build_model(sizes, num_actions, spec.agent, spec.env.obs_mode)
     model.load_state_dict(state["model"])
     model.eval()
-    return model, settings, agent
+    return model, spec
 
 
-def _check_run_labels(checkpoint: pathlib.Path, settings: TrainSettings) -> None:
+def _check_run_labels(checkpoint: pathlib.Path, spec: RunSpec) -> None:
     """Refuse a checkpoint inside a run directory whose task, robot or obs mode differ from the
     run's own ``config.yaml`` (a checkpoint relabelled, or copied into another run)."""
     config = checkpoint.parent.parent / "config.yaml"
     if checkpoint.parent.name != CHECKPOINT_DIR or not config.is_file():
         return
-    run = read_run_config(checkpoint.parent.parent)[0].env
+    run = read_run_config(checkpoint.parent.parent).env
     keys = ("task", "robot", "obs_mode")
-    differ = {
-        k: (getattr(settings.env, k), getattr(run, k)) for k in keys if getattr(settings.env, k) != getattr(run, k)
-    }
+    differ = {k: (getattr(spec.env, k), getattr(run, k)) for k in keys if getattr(spec.env, k) != getattr(run, k)}
     if differ:
         raise ValueError(
             f"checkpoint {str(checkpoint)!r} names {differ} (checkpoint, run), unlike its run's {str(config)!r}: "
@@ -104,8 +100,8 @@ class RunDir:
 
     path: pathlib.Path
 
-    def config(self) -> tuple[TrainSettings, AgentConfig]:
-        """The run's settings and agent config (``config.yaml``)."""
+    def config(self) -> RunSpec:
+        """The run's spec: its envs, agent and budget (``config.yaml``)."""
         return read_run_config(self.path)
 
     def evaluations(self) -> list[dict[str, Any]]:
@@ -124,6 +120,6 @@ class RunDir:
         """Whether checkpoint ``name`` exists (``latest``: whether the run can be continued)."""
         return self.checkpoint(name).is_file()
 
-    def policy(self, name: str = "best") -> tuple[ActorCritic, TrainSettings, AgentConfig]:
-        """The policy of checkpoint ``name`` with the run's settings (``load_policy``: no env built)."""
+    def policy(self, name: str = "best") -> tuple[ActorCritic, RunSpec]:
+        """The policy of checkpoint ``name`` with the run's spec (``load_policy``: no env built)."""
         return load_policy(self.checkpoint(name))

@@ -12,14 +12,14 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
+from roto.envs.aids.settings import aids_from_legacy_fields
 from roto.envs.config import EnvConfig
 from roto.envs.replay_starts import check_replay_starts
-from roto.rl.config import AgentConfig, load_agent_config, load_training_aids, to_dict
+from roto.rl.config import AgentConfig, from_dict, load_agent_config, load_training_aids, to_dict
 from roto.rl.overrides import apply_env_overrides, split_overrides
-from roto.rl.settings import TrainSettings
 from roto.robots import get_robot
 from roto.tasks import get_task
 
@@ -30,16 +30,51 @@ EXECUTION_KEYS = ("env.threads",)
 
 @dataclass(frozen=True, kw_only=True)
 class RunSpec:
-    """A training run: its training envs, its agent and its env-step budget."""
+    """A training run: its training envs, its agent and its env-step budget. What a run's
+    ``config.yaml`` holds (``roto.rl.run_config``), what checkpoints carry and what a trainer is
+    built from."""
 
     env: EnvConfig
-    agent: AgentConfig
+    agent: AgentConfig = field(default_factory=AgentConfig)
+    """Default: roto's PPO as ``AgentConfig`` defines it."""
     steps: int = DEFAULT_STEPS
 
-    @property
-    def settings(self) -> TrainSettings:
-        """The envs and budget as ``TrainSettings`` (what ``config.yaml``'s ``train`` section holds)."""
-        return TrainSettings(env=self.env, total_steps=self.steps)
+    def __post_init__(self) -> None:
+        """A budget below one env step is an error."""
+        if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
+            raise ValueError(f"the step budget must be an integer >= 1, got {self.steps!r}")
+
+    def env_config(self, num_envs: int | None = None, seed: int | None = None, **changes: Any) -> EnvConfig:
+        """The training envs' config, or that of other envs (another num_envs / seed / backend ...)."""
+        changes.update({name: value for name, value in (("num_envs", num_envs), ("seed", seed)) if value is not None})
+        return dataclasses.replace(self.env, **changes)
+
+    def eval_env_config(self, num_envs: int | None = None, seed: int | None = None, **changes: Any) -> EnvConfig:
+        """As ``env_config``, without training aids (``EnvConfig.without_training_aids``): evaluation
+        is always the benchmark's own task."""
+        return self.env_config(num_envs, seed, **changes).without_training_aids()
+
+    def cpu_env_config(self, num_envs: int | None = None, seed: int | None = None, **changes: Any) -> EnvConfig:
+        """As ``eval_env_config``, on the CPU backend: evaluation and videos of any run, GPU-trained too."""
+        return self.eval_env_config(num_envs, seed, backend="cpu", device="cpu", **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain nested dict of builtins: {"env", "agent", "steps"} (config.yaml, checkpoints)."""
+        env = dataclasses.asdict(self.env)
+        env["extra_groups"] = list(env["extra_groups"])
+        env["aids"] = self.env.aids.to_dict()  # the aids that are on
+        return {"env": env, "agent": to_dict(self.agent), "steps": self.steps}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> RunSpec:
+        """Inverse of ``to_dict``; a stored spec of an older layout (``spec_data``) is read too."""
+        data = spec_data(data)
+        env = EnvConfig(**aids_from_legacy_fields(data["env"]))
+        return cls(env=env, agent=from_dict(AgentConfig, data["agent"]).validate(), steps=int(data["steps"]))
+
+    def with_steps(self, steps: int) -> RunSpec:
+        """This run with budget ``steps``."""
+        return dataclasses.replace(self, steps=steps)
 
     def with_seed(self, seed: int) -> RunSpec:
         """This run with env seed ``seed`` (a sweep trial's or an Olympiad cell's own, which wins
@@ -55,6 +90,15 @@ class RunSpec:
         theirs = {"env": dataclasses.asdict(other.env), "agent": to_dict(other.agent)}
         pairs = _flat_pairs(mine, theirs).items()
         return {key: pair for key, pair in pairs if pair[0] != pair[1] and key not in EXECUTION_KEYS}
+
+
+def spec_data(data: dict[str, Any]) -> dict[str, Any]:
+    """A stored spec as {"env", "agent", "steps"}: run configs and checkpoints of formats 1 and 2
+    held the envs and budget in a ``train`` section ({"env", "total_steps"}) beside ``agent``."""
+    if "train" not in data:
+        return data
+    train = data["train"]
+    return {"env": train["env"], "agent": data.get("agent", {}), "steps": train["total_steps"]}
 
 
 def _flat_pairs(a: dict[str, Any], b: dict[str, Any], prefix: str = "") -> dict[str, tuple[Any, Any]]:
@@ -89,9 +133,9 @@ def build_run_spec(
     env_changes, agent_overrides = split_overrides(list(overrides))
     env = training_env(EnvConfig(task=task, robot=robot, obs_mode=obs, **env_fields), agent_cfg, env_changes)
     agent = load_agent_config(task, agent_cfg, agent_overrides)
-    TrainSettings(env=env, total_steps=steps)  # checks the budget
+    spec = RunSpec(env=env, agent=agent, steps=steps)  # checks the budget
     check_replay_starts(env)  # the bank is read now, not when a run, a plan's cell or a sweep's trial starts
-    return RunSpec(env=env, agent=agent, steps=steps)
+    return spec
 
 
 def training_env(env: EnvConfig, agent_cfg: str | None, env_changes: dict[str, Any]) -> EnvConfig:

@@ -6,6 +6,7 @@ orchestrates them, the envs and the run directory.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import pathlib
 import shutil
@@ -23,14 +24,13 @@ from roto.envs.contract import BatchedEnv
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import build_learner, build_model, extra_groups, stacked_sizes
 from roto.rl.checkpoints import load_checkpoint, save_checkpoint
-from roto.rl.config import AgentConfig, to_dict
 from roto.rl.episode_stats import EpisodeStats
 from roto.rl.evaluation import PolicyEvaluator, best_eval_key, load_best_eval
 from roto.rl.logger import ScalarLogger
+from roto.rl.run_config import read_run_config, run_config, write_run_config
 from roto.rl.run_dir import CHECKPOINT_DIR, RunDir, checkpoint_path, first_missing, numbered_checkpoints
 from roto.rl.run_lock import hold_run_lock
 from roto.rl.run_spec import RunSpec
-from roto.rl.settings import TrainSettings, read_run_config, run_config, write_run_config
 from roto.rl.stop_requests import StopRequests
 from roto.rl.torch_threads import single_torch_thread
 from roto.rl.wandb_run import logged_wandb_project, open_wandb_run, require_wandb
@@ -44,8 +44,8 @@ class Trainer:
     """PPO on B training envs, evaluated every ``run.eval_every`` updates on separate envs.
 
     Args:
-        settings: task, robot, obs mode, env count, step budget, seed, backend.
-        agent: network, PPO, auxiliary losses and run settings.
+        spec: the run: its training envs (task, robot, obs mode, env count, seed, backend, aids),
+            its agent (network, PPO, auxiliary losses, run settings) and its step budget.
         run_dir: where config, logs, evaluations and checkpoints go (created).
         tensorboard: also write TensorBoard event files (and draw the learning curve at the end).
         env_factory: builds an env from an ``EnvConfig`` (default ``RotoEnv``); tests pass a toy env
@@ -56,8 +56,7 @@ class Trainer:
 
     def __init__(
         self,
-        settings: TrainSettings,
-        agent: AgentConfig,
+        spec: RunSpec,
         run_dir: str | pathlib.Path,
         tensorboard: bool = True,
         env_factory: Callable[[EnvConfig], BatchedEnv] = RotoEnv,
@@ -65,9 +64,9 @@ class Trainer:
     ) -> None:
         if wandb_project is not None:
             require_wandb()
-        self.settings, self.agent = settings, agent
+        self.spec, self.agent = spec, spec.agent
         self.run_dir = pathlib.Path(run_dir)
-        extra = extra_groups(agent, settings.env.obs_mode)  # checks the groups before anything is built
+        extra = extra_groups(spec.agent, spec.env.obs_mode)  # checks the groups before anything is built
         created = first_missing(self.run_dir)
         (self.run_dir / CHECKPOINT_DIR).mkdir(parents=True, exist_ok=True)
         self._lock = hold_run_lock(self.run_dir)  # held from here until train() returns
@@ -81,23 +80,23 @@ class Trainer:
             raise
         self.tensorboard = tensorboard
         self.wandb_project = wandb_project
-        write_run_config(self.run_dir, settings, agent)
+        write_run_config(self.run_dir, spec)
 
     def _build(self, env_factory: Callable[[EnvConfig], BatchedEnv], extra: tuple[str, ...]) -> None:
         """The envs, the evaluator, the model and the learner; the counters at zero."""
-        settings, agent = self.settings, self.agent
-        self.env = env_factory(settings.env_config(extra_groups=extra))
+        spec, agent = self.spec, self.agent
+        self.env = env_factory(spec.env_config(extra_groups=extra))
         self.device = self.env.device  # the policy learns where the envs simulate
         num_eval = agent.run.num_eval_envs_gpu if self.device.type == "cuda" else agent.run.num_eval_envs
-        eval_seed = settings.env.seed + EVAL_SEED_OFFSET
+        eval_seed = spec.env.seed + EVAL_SEED_OFFSET
         self.evaluator = PolicyEvaluator(
-            env_factory(for_path_metrics(settings.eval_env_config(num_eval, eval_seed))), eval_seed, self.run_dir
+            env_factory(for_path_metrics(spec.eval_env_config(num_eval, eval_seed))), eval_seed, self.run_dir
         )
-        torch.manual_seed(settings.env.seed)
+        torch.manual_seed(spec.env.seed)
         sizes = stacked_sizes(self.env)
-        self.model = build_model(sizes, self.env.num_actions, agent, settings.env.obs_mode).to(self.device)
+        self.model = build_model(sizes, self.env.num_actions, agent, spec.env.obs_mode).to(self.device)
         self.alg = build_learner(
-            self.model, sizes, self.env.num_actions, settings.env.num_envs, agent, settings.env.seed, settings.env.touch
+            self.model, sizes, self.env.num_actions, spec.env.num_envs, agent, spec.env.seed, spec.env.touch
         )
         self.episodes = EpisodeStats(self.env.task.metric_names, self.device)
         self.update = 0
@@ -111,12 +110,12 @@ class Trainer:
     @property
     def steps_per_update(self) -> int:
         """Env steps collected per PPO update (rollouts x num_envs)."""
-        return self.agent.ppo.rollouts * self.settings.env.num_envs
+        return self.agent.ppo.rollouts * self.spec.env.num_envs
 
     @property
     def total_updates(self) -> int:
         """Updates needed for the step budget (at least one)."""
-        return max(1, math.ceil(self.settings.total_steps / self.steps_per_update))
+        return max(1, math.ceil(self.spec.steps / self.steps_per_update))
 
     # ------------------------------------------------------------------------ training
 
@@ -131,9 +130,9 @@ class Trainer:
         if self._lock is None:
             self._lock = hold_run_lock(self.run_dir)
         if self.obs is None:
-            self.obs, _ = self.env.reset(seed=self.settings.env.seed)
+            self.obs, _ = self.env.reset(seed=self.spec.env.seed)
         logger = self._open_logger()
-        env = self.settings.env
+        env = self.spec.env
         bar = tqdm(
             total=self.total_updates * self.steps_per_update,
             initial=self.env_steps,
@@ -190,7 +189,7 @@ class Trainer:
         """The run's CSV, with TensorBoard and the W&B run as asked."""
         wandb_run = None
         if self.wandb_project is not None:
-            wandb_run = open_wandb_run(self.run_dir, self.wandb_project, run_config(self.settings, self.agent))
+            wandb_run = open_wandb_run(self.run_dir, self.wandb_project, run_config(self.spec))
         return ScalarLogger(self.run_dir, self.tensorboard, wandb_run, update=self.update, env_steps=self.env_steps)
 
     def _collect_rollout(self) -> dict[str, float]:
@@ -265,8 +264,7 @@ class Trainer:
         return {
             **format_stamp("checkpoint"),
             "model": self.model.state_dict(),
-            "train": self.settings.to_dict(),
-            "agent": to_dict(self.agent),
+            "spec": self.spec.to_dict(),
             "obs_sizes": stacked_sizes(self.env),
             "num_actions": self.env.num_actions,
             "update": self.update,
@@ -330,9 +328,7 @@ class Trainer:
         run_dir = pathlib.Path(run_dir)
         if spec is None or RunDir(run_dir).has_checkpoint():
             if spec is not None:
-                settings, agent = RunDir(run_dir).config()
-                stored = RunSpec(env=settings.env, agent=agent, steps=settings.total_steps)
-                differ = spec.differences(stored)
+                differ = spec.differences(RunDir(run_dir).config())
                 if differ:
                     raise ValueError(
                         f"run {str(run_dir)!r} exists with other settings (given, stored): {differ}; continue it as "
@@ -341,7 +337,7 @@ class Trainer:
                 steps = spec.steps
             threads = spec.env.threads if spec is not None else None
             return cls.resume(run_dir, steps, tensorboard, env_factory, wandb_project, threads=threads)
-        trainer = cls(spec.settings, spec.agent, run_dir, tensorboard, env_factory, wandb_project)
+        trainer = cls(spec, run_dir, tensorboard, env_factory, wandb_project)
         trainer.evaluator.drop_after(0)  # a run that died before its first checkpoint starts over, records too
         return trainer
 
@@ -362,7 +358,7 @@ class Trainer:
         A run that logged to W&B continues its W&B run; ``wandb_project`` adds W&B to one that did not.
         """
         run_dir = pathlib.Path(run_dir)
-        settings, agent = read_run_config(run_dir)
+        spec = read_run_config(run_dir)
         checkpoint = checkpoint_path(run_dir, "latest")
         if not checkpoint.is_file():
             raise FileNotFoundError(f"no checkpoint to resume from: {str(checkpoint)!r} does not exist")
@@ -378,12 +374,10 @@ class Trainer:
                 "already done; give a budget at least that large"
             )
         if total_steps is not None:
-            settings = TrainSettings(env=settings.env, total_steps=total_steps)
+            spec = spec.with_steps(total_steps)
         if threads is not None:
-            settings = TrainSettings(env=settings.env_config(threads=threads), total_steps=settings.total_steps)
+            spec = dataclasses.replace(spec, env=spec.env_config(threads=threads))
         wandb_project = logged_wandb_project(run_dir) or wandb_project
-        trainer = cls(
-            settings, agent, run_dir, tensorboard=tensorboard, env_factory=env_factory, wandb_project=wandb_project
-        )
+        trainer = cls(spec, run_dir, tensorboard=tensorboard, env_factory=env_factory, wandb_project=wandb_project)
         trainer.load_state_dict(state if trainer.device.type == "cpu" else load_checkpoint(checkpoint, trainer.device))
         return trainer

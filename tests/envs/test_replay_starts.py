@@ -8,7 +8,7 @@ import torch
 import roto
 from roto.envs.aids.replayed_starts import ReplayedStarts
 from roto.envs.config import EnvConfig
-from roto.rl.settings import TrainSettings
+from roto.rl.run_spec import RunSpec
 from tests.conftest import SHADOW_BANK
 
 BANK = SHADOW_BANK  # the Shadow reference controller's pre-swap states
@@ -93,7 +93,7 @@ def test_resume_continues_bit_identically_with_replayed_starts():
 
 def test_evaluation_envs_never_replay():
     env = EnvConfig(task="baoding", aids=replayed(BANK, 0.5))
-    settings = TrainSettings(env=env)
+    settings = RunSpec(env=env)
     assert (
         settings.eval_env_config(8, 1).aids.replayed_starts is None and settings.eval_env_config().aids.active() == {}
     )
@@ -122,8 +122,8 @@ def test_a_missing_states_file_is_refused_by_the_env_and_a_run_s_config_still_lo
     with pytest.raises(ValueError, match=r"aids.replayed_starts.bank '/nowhere/states.npz' is not a file"):
         roto.make("baoding", aids=replayed("/nowhere/states.npz", 0.5))
     # a run trained with the aid is still evaluated where the file is gone (eval drops the aid)
-    settings = TrainSettings.from_dict(
-        {"env": {"task": "baoding", "aids": replayed("/nowhere/states.npz", 0.5)}, "total_steps": 10}
+    settings = RunSpec.from_dict(
+        {"env": {"task": "baoding", "aids": replayed("/nowhere/states.npz", 0.5)}, "agent": {}, "steps": 10}
     )
     env = roto.make(**vars(settings.eval_env_config(num_envs=1)))
     assert env.aid(ReplayedStarts) is None

@@ -5,7 +5,7 @@ import torch
 from roto.envs.config import EnvConfig
 from roto.eval.bounce_rhythm import record_rhythm, rhythm
 from roto.rl.networks import ActorCritic
-from roto.rl.runner import TrainSettings
+from roto.rl.run_spec import RunSpec
 from roto.tasks.bounce import MIN_FLIGHT_STEPS, bounce_counter
 
 
@@ -62,7 +62,7 @@ def test_random_records_agree_with_the_bounce_rule():
 
 
 def test_recorded_episodes_match_the_envs_own_count():
-    settings = TrainSettings(env=EnvConfig(task="bounce", robot="shadow", num_envs=2, threads=1, episode_steps=60))
+    settings = RunSpec(env=EnvConfig(task="bounce", robot="shadow", num_envs=2, threads=1, episode_steps=60))
     policy = ActorCritic({"tactile": 68, "proprio": 320}, 20, actor_groups=("tactile", "proprio"), encoder=(16,))
     contact, bounce, height, lengths = record_rhythm(policy, settings, envs=2, seed=3)
     assert contact.shape == bounce.shape == height.shape == (60, 2)
@@ -75,7 +75,7 @@ def test_recorded_episodes_match_the_envs_own_count():
 
 @pytest.mark.parametrize(("task", "envs", "named"), [("baoding", 2, "'baoding'"), ("bounce", 0, "got 0")])
 def test_a_run_of_another_task_or_no_envs_is_refused_by_name(task, envs, named):
-    settings = TrainSettings(env=EnvConfig(task=task, robot="shadow", num_envs=2, threads=1))
+    settings = RunSpec(env=EnvConfig(task=task, robot="shadow", num_envs=2, threads=1))
     policy = ActorCritic({"tactile": 68, "proprio": 320}, 20, actor_groups=("tactile", "proprio"), encoder=(16,))
     with pytest.raises(ValueError, match=named):
         record_rhythm(policy, settings, envs=envs)

@@ -5,7 +5,7 @@ from roto.envs.episodes import first_episodes
 from roto.envs.roto_env import RotoEnv
 from roto.eval.evaluate import evaluate
 from roto.rl.networks import ActorCritic
-from roto.rl.runner import TrainSettings
+from roto.rl.run_spec import RunSpec
 
 
 class ThreadRecordingPolicy(ActorCritic):
@@ -21,7 +21,7 @@ class ThreadRecordingPolicy(ActorCritic):
 
 
 def test_evaluate_runs_whole_episodes_on_one_torch_thread_and_restores_the_count():
-    settings = TrainSettings(env=EnvConfig(task="bounce", robot="shadow", num_envs=2, threads=2))
+    settings = RunSpec(env=EnvConfig(task="bounce", robot="shadow", num_envs=2, threads=2))
     sizes = {"tactile": 68, "proprio": 320}
     policy = ThreadRecordingPolicy(
         sizes, 20, actor_groups=("tactile", "proprio"), encoder=(32,), policy_head=(16,), value_head=(16,)
@@ -48,7 +48,7 @@ def untrained_blind_policy() -> ActorCritic:
 
 
 def test_a_baoding_evaluation_adds_the_pair_turns_and_leaves_the_episodes_as_they_were():
-    settings = TrainSettings(env=EnvConfig(task="baoding", robot="shadow", num_envs=2))
+    settings = RunSpec(env=EnvConfig(task="baoding", robot="shadow", num_envs=2))
     policy = untrained_blind_policy()
     summary = evaluate(policy, settings, episodes=2, seed=5)
     env = RotoEnv(settings.cpu_env_config(num_envs=2, seed=5))  # the same episodes without the ball state
@@ -66,6 +66,6 @@ def test_a_baoding_evaluation_adds_the_pair_turns_and_leaves_the_episodes_as_the
 
 
 def test_a_bounce_evaluation_has_no_path_metrics():
-    settings = TrainSettings(env=EnvConfig(task="bounce", robot="shadow", num_envs=1))
+    settings = RunSpec(env=EnvConfig(task="bounce", robot="shadow", num_envs=1))
     summary = evaluate(untrained_blind_policy(), settings, episodes=1)
     assert set(summary["per_episode"]) == {"return", "length", "bounces"}

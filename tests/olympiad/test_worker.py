@@ -174,7 +174,7 @@ def test_cli_olympiad_with_two_workers_on_the_real_env_then_results(tmp_path, ca
     assert main(["results", str(plan_path), "--root", str(root), "--out", str(tmp_path / "out")]) == 0
     assert "| allegro | " in (tmp_path / "out" / "results.md").read_text()
     for cell in ("bounce-shadow-blind-ppo-seed0", "bounce-allegro-blind-ppo-seed0"):  # the plan's default is 1
-        assert yaml.safe_load((root / "real" / cell / "config.yaml").read_text())["train"]["env"]["threads"] == 2
+        assert yaml.safe_load((root / "real" / cell / "config.yaml").read_text())["env"]["threads"] == 2
 
 
 def test_cli_olympiad_refuses_a_thread_count_below_one_by_value(tmp_path, capsys):

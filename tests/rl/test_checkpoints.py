@@ -40,7 +40,7 @@ def test_files_that_are_not_roto_checkpoints_are_clear_errors(tmp_path):
     with pytest.raises(ValueError, match=r"notes\.txt' is not a roto checkpoint"):
         load_checkpoint(tmp_path / "notes.txt")
     torch.save({"weights": torch.ones(1)}, tmp_path / "other.pt")
-    with pytest.raises(ValueError, match="lacks the model, train and agent"):
+    with pytest.raises(ValueError, match="lacks the model and spec entries"):
         load_checkpoint(tmp_path / "other.pt")
     with pytest.raises(FileNotFoundError, match="does not exist"):
         load_checkpoint(tmp_path / "missing.pt")

@@ -9,7 +9,8 @@ from roto.envs.aids.event_recorder import RecordedEvents
 from roto.envs.aids.tolerance import ToleranceAid
 from roto.envs.config import EnvConfig
 from roto.rl.config import load_agent_config
-from roto.rl.runner import Trainer, TrainSettings
+from roto.rl.run_spec import RunSpec
+from roto.rl.runner import Trainer
 from tests.conftest import BAODING_AIDS, require_warp
 
 
@@ -28,8 +29,8 @@ def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch,
     agent = load_agent_config(
         "baoding_cpu_shadow", overrides=["ppo.rollouts=8", "run.eval_every=100", "run.num_eval_envs=2"]
     )
-    settings = TrainSettings(env=env, total_steps=3 * agent.ppo.rollouts * env.num_envs)
-    trainer = Trainer(settings, agent, tmp_path / "run", tensorboard=False)
+    spec = RunSpec(env=env, agent=agent, steps=3 * agent.ppo.rollouts * env.num_envs)
+    trainer = Trainer(spec, tmp_path / "run", tensorboard=False)
     trainer.env.checks.go_sync_free(4)  # as on a GPU
     assert trainer.env.aid(RecordedEvents) is not None and trainer.env.aid(ToleranceAid) is not None
     collect, collected = trainer._collect_rollout, []

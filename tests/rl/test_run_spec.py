@@ -75,7 +75,7 @@ def test_open_creates_then_continues_a_run_and_refuses_other_settings(tmp_path):
     first.train(progress=False)
     longer = build_run_spec("bounce", obs="proprio", overrides=TINY, steps=64, num_envs=4)
     again = Trainer.open(run, longer, tensorboard=False, env_factory=ToyEnv)  # same run, a larger budget
-    assert again.update == 2 and again.settings.total_steps == 64
+    assert again.update == 2 and again.spec.steps == 64
     again.train(progress=False)
     other = build_run_spec("bounce", obs="proprio", overrides=[*TINY, "ppo.lr=1e-3"], steps=64, num_envs=4)
     with pytest.raises(ValueError, match=r"exists with other settings .*'agent.ppo.lr': \(0.001, 0.000259\)"):

@@ -3,7 +3,8 @@ import torch
 
 from roto.envs.config import EnvConfig
 from roto.rl.config import load_agent_config
-from roto.rl.runner import Trainer, TrainSettings
+from roto.rl.run_spec import RunSpec
+from roto.rl.runner import Trainer
 from tests.rl.toy_env import ToyEnv
 
 TINY = [
@@ -19,9 +20,8 @@ TINY = [
 
 def tiny_trainer(tmp_path, name, updates, extra=(), **kwargs):
     env = EnvConfig(task="bounce", robot="shadow", num_envs=4, seed=3)
-    settings = TrainSettings(env=env, total_steps=16 * updates)
     agent = load_agent_config("bounce", overrides=[*TINY, *extra])
-    return Trainer(settings, agent, tmp_path / name, tensorboard=False, **kwargs)
+    return Trainer(RunSpec(env=env, agent=agent, steps=16 * updates), tmp_path / name, tensorboard=False, **kwargs)
 
 
 def params(trainer):
@@ -78,11 +78,11 @@ def test_a_run_continued_on_other_threads_trains_as_the_uninterrupted_run(tmp_pa
     whole.train(progress=False)
     Trainer.open(tmp_path / "part", spec(2, 2), tensorboard=False).train(progress=False)
     resumed = Trainer.open(tmp_path / "part", spec(3, 1), tensorboard=False)
-    assert resumed.update == 2 and resumed.settings.env.threads == 1
+    assert resumed.update == 2 and resumed.spec.env.threads == 1
     resumed.train(progress=False)
     pw, pr = params(whole), params(resumed)
     assert all(torch.equal(pw[k], pr[k]) for k in pw)
-    assert RunDir(tmp_path / "part").config()[0].env.threads == 1  # config.yaml says what it ran on last
+    assert RunDir(tmp_path / "part").config().env.threads == 1  # config.yaml says what it ran on last
 
 
 AGENT_V2 = [
@@ -139,9 +139,7 @@ def test_resume_without_a_checkpoint_is_a_clear_error(tmp_path):
 
 def test_ppo_learns_the_toy_task(tmp_path):
     torch.set_num_threads(1)
-    settings = TrainSettings(
-        env=EnvConfig(task="bounce", obs_mode="proprio", num_envs=32, seed=0), total_steps=32 * 8 * 60
-    )
+    env = EnvConfig(task="bounce", obs_mode="proprio", num_envs=32, seed=0)
     agent = load_agent_config(
         "bounce",
         overrides=[
@@ -157,7 +155,8 @@ def test_ppo_learns_the_toy_task(tmp_path):
             "run.num_eval_envs=16",
         ],
     )
-    trainer = Trainer(settings, agent, tmp_path / "toy", tensorboard=False, env_factory=ToyEnv)
+    spec = RunSpec(env=env, agent=agent, steps=32 * 8 * 60)
+    trainer = Trainer(spec, tmp_path / "toy", tensorboard=False, env_factory=ToyEnv)
     last = trainer.train(progress=False)
     # random actions in [-1, 1] earn about 8 * (1 - 2/3) = 2.7 per 8-step episode; the optimum is 8
     assert last["eval/return_mean"] > 7.0, last
@@ -179,12 +178,10 @@ def test_best_checkpoint_holds_exactly_the_weights_of_the_best_evaluation(tmp_pa
     from roto.rl.checkpoints import load_checkpoint
     from roto.rl.evaluation import read_evaluations
 
-    settings = TrainSettings(
-        env=EnvConfig(task="bounce", obs_mode="proprio", num_envs=8, seed=0), total_steps=8 * 8 * 6
-    )
     overrides = [*TINY, "ppo.rollouts=8", "ppo.lr=3e-3", "run.num_eval_envs=5", "run.eval_every=1"]
-    trainer = Trainer(settings, load_agent_config("bounce", overrides=overrides), tmp_path / "toy", tensorboard=False,
-                      env_factory=CountingToyEnv)  # fmt: skip
+    env = EnvConfig(task="bounce", obs_mode="proprio", num_envs=8, seed=0)
+    spec = RunSpec(env=env, agent=load_agent_config("bounce", overrides=overrides), steps=8 * 8 * 6)
+    trainer = Trainer(spec, tmp_path / "toy", tensorboard=False, env_factory=CountingToyEnv)
     trainer.train(progress=False)
     records = read_evaluations(tmp_path / "toy")
     assert [r["update"] for r in records] == [1, 2, 3, 4, 5, 6]
@@ -240,7 +237,7 @@ def test_best_and_numbered_checkpoints_hold_the_policy_and_load_without_an_env(t
         raise AssertionError("loading a policy built an env")
 
     monkeypatch.setattr(runner, "RotoEnv", no_env)
-    model, _, _ = runner.load_policy(folder / "agent_2.pt")
+    model, _ = runner.load_policy(folder / "agent_2.pt")
     trained = trainer.model.state_dict()
     assert all(torch.equal(value, trained[key]) for key, value in model.state_dict().items())
 
@@ -259,14 +256,14 @@ def test_a_run_directory_reads_back_what_training_wrote(tmp_path):
     trainer = tiny_trainer(tmp_path, "run", 2, extra=["run.eval_every=1"])
     trainer.train(progress=False)
     run = RunDir(tmp_path / "run")
-    settings, agent = run.config()
-    assert settings == trainer.settings and agent == trainer.agent
+    spec = run.config()
+    assert spec == trainer.spec and spec.agent == trainer.agent
     assert [r["update"] for r in run.evaluations()] == [1, 2]
     steps, values = run.scalars()["eval/return_mean"]
     assert steps == [16, 32] and values == [r["return_mean"] for r in run.evaluations()]
     assert run.has_checkpoint() and run.has_checkpoint("best") and not run.has_checkpoint("agent_7")
-    model, loaded_settings, _ = run.policy("latest")
-    assert loaded_settings == settings
+    model, loaded = run.policy("latest")
+    assert loaded == spec
     assert all(torch.equal(v, trainer.model.state_dict()[k]) for k, v in model.state_dict().items())
 
 

@@ -6,7 +6,8 @@ import torch
 
 from roto.envs.config import EnvConfig
 from roto.rl.config import load_agent_config
-from roto.rl.runner import Trainer, TrainSettings
+from roto.rl.run_spec import RunSpec
+from roto.rl.runner import Trainer
 
 pytestmark = [pytest.mark.gpu, pytest.mark.skipif(not torch.cuda.is_available(), reason="needs an NVIDIA GPU")]
 
@@ -14,8 +15,8 @@ pytestmark = [pytest.mark.gpu, pytest.mark.skipif(not torch.cuda.is_available(),
 def test_gpu_rollouts_never_wait_for_the_device(tmp_path, monkeypatch):
     env = EnvConfig(task="bounce", robot="shadow", num_envs=2048, backend="warp", device="cuda", seed=0)
     agent = load_agent_config("bounce", overrides=["run.eval_every=2", "run.num_eval_envs_gpu=16"])
-    settings = TrainSettings(env=env, total_steps=3 * agent.ppo.rollouts * env.num_envs)
-    trainer = Trainer(settings, agent, tmp_path / "run", tensorboard=False)
+    spec = RunSpec(env=env, agent=agent, steps=3 * agent.ppo.rollouts * env.num_envs)
+    trainer = Trainer(spec, tmp_path / "run", tensorboard=False)
     collect = trainer._collect_rollout
     rollouts = []
 
@@ -30,6 +31,6 @@ def test_gpu_rollouts_never_wait_for_the_device(tmp_path, monkeypatch):
 
     monkeypatch.setattr(trainer, "_collect_rollout", collect_without_waiting)
     summary = trainer.train(progress=False)
-    assert len(rollouts) == 3 and trainer.env_steps == settings.total_steps
+    assert len(rollouts) == 3 and trainer.env_steps == spec.steps
     assert all(torch.isfinite(p).all() for p in trainer.model.parameters())
     assert summary and (tmp_path / "run" / "evaluations.jsonl").is_file()

@@ -93,7 +93,7 @@ def test_the_wandb_run_is_named_after_the_run_and_holds_its_config(wandb_run):
     run, _ = runs[min(runs)]  # the first W&B session (the resume test may have added a second)
     assert (run.run_id, run.project, run.display_name) == (stored["id"], "roto", "run") and stored["project"] == "roto"
     config = {item.key: yaml.safe_load(item.value_json) for item in run.config.update}
-    assert config["agent"]["ppo"]["rollouts"] == 4 and config["train"]["env"]["num_envs"] == 4
+    assert config["agent"]["ppo"]["rollouts"] == 4 and config["env"]["num_envs"] == 4
 
 
 def test_resume_continues_the_same_wandb_run(wandb_run):

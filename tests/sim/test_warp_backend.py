@@ -299,7 +299,7 @@ def test_train_on_warp_then_evaluate_on_the_cpu_backend(tmp_path, capsys):
     args = ["train", "--backend", "warp", "--robot", "allegro", "--num_envs", "2", "--steps", "16"]
     assert main([*args, "--run_dir", str(run_dir), "--no_progress", *TINY]) == 0
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
-    assert summary["settings"]["env"]["backend"] == "warp" and summary["env_steps"] == 16
+    assert summary["spec"]["env"]["backend"] == "warp" and summary["env_steps"] == 16
     assert "perf/simulation_s" in (run_dir / "scalars.csv").read_text()
     checkpoint = run_dir / "checkpoints" / "latest.pt"
     assert main(["eval", "--checkpoint", str(checkpoint), "--episodes", "1", "--out", str(tmp_path / "e.json")]) == 0

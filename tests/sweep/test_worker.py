@@ -47,8 +47,8 @@ def test_a_four_trial_toy_sweep_completes_and_exports_a_loadable_config(tmp_path
         config = yaml.safe_load((run_dir / "config.yaml").read_text())
         assert config["agent"]["ppo"]["lr"] == trial.params["ppo.lr"]
         assert config["agent"]["ppo"]["epochs"] == trial.params["ppo.epochs"]
-        assert config["train"]["env"]["action_smoothing"] == trial.params["env.action_smoothing"]
-        assert config["train"]["env"]["seed"] == trial.user_attrs["seed"]
+        assert config["env"]["action_smoothing"] == trial.params["env.action_smoothing"]
+        assert config["env"]["seed"] == trial.user_attrs["seed"]
 
     out = tmp_path / "best.yaml"
     summary = export_best(settings.study, settings.root, None, out)

@@ -10,7 +10,7 @@ import torch
 
 import roto
 from roto.envs.config import EnvConfig
-from roto.rl.settings import TrainSettings
+from roto.rl.run_spec import RunSpec
 from roto.robots import get_robot
 from roto.tasks.baoding import SWAP_REWARD, Baoding
 from roto.tasks.base import TaskInputs
@@ -115,7 +115,7 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids={"round_swaps": {"min_turn": 0.25}})
     assert float(env.task_state.min_turn) == 0.25
     assert float(roto.make("baoding", robot="shadow", num_envs=2, seed=0).task_state.min_turn) == 0.0
-    settings = TrainSettings(env=EnvConfig(task="baoding", aids={"round_swaps": {}}))  # a quarter turn by default
+    settings = RunSpec(env=EnvConfig(task="baoding", aids={"round_swaps": {}}))  # a quarter turn by default
     assert (
         settings.eval_env_config(4).aids.round_swaps is None and settings.env_config().aids.round_swaps.min_turn == 0.25
     )

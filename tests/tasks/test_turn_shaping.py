@@ -10,7 +10,7 @@ import torch
 
 import roto
 from roto.envs.config import EnvConfig
-from roto.rl.settings import TrainSettings
+from roto.rl.run_spec import RunSpec
 from roto.tasks.baoding import Baoding
 from roto.tasks.base import TaskInputs
 from roto.tasks.round_swaps import turn_shaping
@@ -62,7 +62,7 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids={"turn_shaping": {"per_turn": 20.0}})
     assert float(env.task_state.turn_reward) == 20.0 and [type(a).__name__ for a in env.aids] == ["TurnShaping"]
     assert float(roto.make("baoding", robot="shadow", num_envs=2, seed=0).task_state.turn_reward) == 0.0
-    settings = TrainSettings(env=EnvConfig(task="baoding", aids={"turn_shaping": {"per_turn": 20.0}}))
+    settings = RunSpec(env=EnvConfig(task="baoding", aids={"turn_shaping": {"per_turn": 20.0}}))
     assert (
         settings.eval_env_config(4).aids.turn_shaping is None and settings.env_config().aids.turn_shaping.per_turn == 20
     )

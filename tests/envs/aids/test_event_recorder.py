@@ -224,7 +224,7 @@ def test_a_resumed_env_draws_its_starts_when_the_original_does_from_the_states_r
 
 def test_recording_needs_replayed_starts_and_evaluation_never_records():
     from roto.envs.config import EnvConfig
-    from roto.rl.settings import TrainSettings
+    from roto.rl.run_spec import RunSpec
 
     with pytest.raises(
         ValueError, match=r"record_lead 10 records states for replayed starts, but aids.replayed_starts.share"
@@ -233,7 +233,7 @@ def test_recording_needs_replayed_starts_and_evaluation_never_records():
     with pytest.raises(ValueError, match=r"aids\.replayed_starts\.record_capacity must be an integer >= 1, got 0"):
         EnvConfig(task="baoding", aids={"replayed_starts": {"bank": "b.npz", "record_capacity": 0}})
     config = EnvConfig(task="bounce", aids={"replayed_starts": {"bank": "bank.npz", "share": 0.5, "record_lead": 10}})
-    assert TrainSettings(env=config).eval_env_config(4).aids.replayed_starts is None
+    assert RunSpec(env=config).eval_env_config(4).aids.replayed_starts is None
 
 
 def test_a_reset_mid_run_starts_every_metric_over(tmp_path):

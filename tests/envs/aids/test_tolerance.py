@@ -8,7 +8,7 @@ import roto
 from roto.envs.aids.protocol import StepContext
 from roto.envs.aids.tolerance import EPISODE_WEIGHT, ToleranceAid, ToleranceCurriculum
 from roto.envs.config import EnvConfig
-from roto.rl.settings import TrainSettings
+from roto.rl.run_spec import RunSpec
 from roto.tasks.baoding import SUCCESS_RADIUS, baoding_rule
 
 
@@ -87,7 +87,7 @@ def test_bad_tolerance_settings_are_refused(task, settings, pattern):
 
 
 def test_evaluation_envs_use_the_benchmarks_radius():
-    settings = TrainSettings(env=EnvConfig(task="baoding", aids={"tolerance": {"start": 0.025}}))
+    settings = RunSpec(env=EnvConfig(task="baoding", aids={"tolerance": {"start": 0.025}}))
     assert settings.eval_env_config(4).aids.tolerance is None and settings.cpu_env_config(1).aids.tolerance is None
     assert settings.env_config().aids.tolerance.start == 0.025
 
@@ -120,6 +120,6 @@ def test_training_logs_the_radius_and_config_yaml_names_the_aid(tmp_path):
         if r["tag"] == "train/success_radius"
     ]
     assert len(radii) == 3 and all(SUCCESS_RADIUS <= r <= 0.03 for r in radii)
-    assert yaml.safe_load((run_dir / "config.yaml").read_text())["train"]["env"]["aids"] == {
+    assert yaml.safe_load((run_dir / "config.yaml").read_text())["env"]["aids"] == {
         "tolerance": {"start": 0.03, "target": 1.0}
     }
