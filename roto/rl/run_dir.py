@@ -14,8 +14,7 @@ import pathlib
 from dataclasses import dataclass
 from typing import Any
 
-from roto.envs.roto_env import RotoEnv
-from roto.rl.build import build_model, extra_groups, stacked_sizes
+from roto.rl.build import build_model
 from roto.rl.checkpoints import load_checkpoint
 from roto.rl.evaluation import read_evaluations
 from roto.rl.logger import CSV_NAME
@@ -55,12 +54,9 @@ def load_policy(checkpoint: str | pathlib.Path) -> tuple[ActorCritic, RunSpec]:
     state = load_checkpoint(checkpoint)
     spec = RunSpec.from_dict(state.get("spec") or state)  # formats 1 and 2: "train" and "agent"
     _check_run_labels(pathlib.Path(checkpoint), spec)
-    if "obs_sizes" in state:
-        sizes, num_actions = {k: int(v) for k, v in state["obs_sizes"].items()}, int(state["num_actions"])
-    else:  # written before checkpoints carried their sizes: an env tells them
-        env = RotoEnv(spec.cpu_env_config(num_envs=1, extra_groups=extra_groups(spec.agent, spec.env.obs_mode)))
-        sizes, num_actions = stacked_sizes(env), env.num_actions
-        env.close()
+    if "obs_sizes" not in state:
+        raise ValueError(f"{str(checkpoint)!r} predates checkpoints that name their observation sizes; retrain it")
+    sizes, num_actions = {k: int(v) for k, v in state["obs_sizes"].items()}, int(state["num_actions"])
     model = build_model(sizes, num_actions, spec.agent, spec.env.obs_mode)
     model.load_state_dict(state["model"])
     model.eval()
