@@ -14,8 +14,8 @@ A plan is a YAML file::
         bounce: {agent_cfg: bounce_cpu, overrides: [ppo.entropy_coef=0.004, env.touch=force]}
       replayed:             # {robot} in an override or the agent config becomes each cell's hand
         baoding: {overrides: ["env.aids.replayed_starts.bank=starts/{robot}.npz", env.aids.replayed_starts.share=0.25]}
-      tuned:                # a config per hand (each must exist for every hand the grids name)
-        bounce: {agent_cfg: "bounce_cpu_{robot}"}
+      recipe:               # each pair's packaged recipe, named in the hand's record (PairRecord.recipe)
+        bounce: {agent_cfg: "{recipe}"}
     grids:                  # the cells: the union of these products
       - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0, 1]}
 
@@ -49,7 +49,9 @@ stands beside that agent's roto v1 figure in ``roto results``; a variant that de
 privileged critic, a swept config, another touch) stands beside none."""
 GRID_KEYS = {"tasks", "robots", "obs", "variants", "seeds"}
 ROBOT_FIELD = "{robot}"
-"""Written in a variant's override, replaced by each cell's robot name."""
+"""Written in a variant's override or agent config, replaced by each cell's robot name."""
+RECIPE_FIELD = "{recipe}"
+"""Written as a variant's agent config: each cell's pair's packaged recipe (``PairRecord.recipe``)."""
 
 
 @dataclass(frozen=True)
@@ -87,11 +89,14 @@ class Variant:
     def agent_for(self, task: str, robot: str | None = None) -> tuple[str | None, list[str]]:
         """(agent config, overrides) this variant trains ``task`` with; with ``robot``, ``{robot}``
         in the agent config or an override becomes the robot's name (a per-hand config, a per-hand
-        file such as replayed starts)."""
+        file such as replayed starts), and ``{recipe}`` as the agent config the pair's packaged
+        recipe (``PairRecord.recipe``)."""
         entry = self.for_task(task)
         if robot is None:
             return entry.agent_cfg, list(entry.overrides)
         agent_cfg = entry.agent_cfg.replace(ROBOT_FIELD, robot) if entry.agent_cfg else entry.agent_cfg
+        if agent_cfg == RECIPE_FIELD:
+            agent_cfg = ROBOTS[robot].tasks[task].recipe
         return agent_cfg, [o.replace(ROBOT_FIELD, robot) for o in entry.overrides]
 
 

@@ -249,8 +249,10 @@ ALLEGRO = RobotSpec(
     baoding_targets=side_by_side((0.0589, 0.0, 0.0217), _BAODING_RADIUS, (0.0, -1.0, 0.0)),
     tasks=MappingProxyType(
         {
-            "bounce": PairRecord(reference=11.8, warp_peaks=(23, 92), script=ALLEGRO_BOUNCE),
-            "baoding": PairRecord(reference=5.03, warp_peaks=(24, 96)),
+            "bounce": PairRecord(
+                reference=11.8, warp_peaks=(23, 92), recipe="bounce_cpu_quickstart", script=ALLEGRO_BOUNCE
+            ),
+            "baoding": PairRecord(reference=5.03, warp_peaks=(24, 96), recipe="baoding_cpu_allegro"),
         }
     ),
 )

@@ -154,8 +154,8 @@ ORCA = RobotSpec(
     ),
     tasks=MappingProxyType(
         {
-            "bounce": PairRecord(reference=12.0, warp_peaks=(63, 270), script=ORCA_BOUNCE),
-            "baoding": PairRecord(reference=5.78, warp_peaks=(65, 277)),
+            "bounce": PairRecord(reference=12.0, warp_peaks=(63, 270), recipe="bounce_cpu_orca", script=ORCA_BOUNCE),
+            "baoding": PairRecord(reference=5.78, warp_peaks=(65, 277), recipe="baoding_cpu_orca"),
         }
     ),
 )

@@ -130,8 +130,10 @@ SHADOW = RobotSpec(
     baoding_targets=diagonal_stack((0.0577, -0.0079, -0.0066), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
     tasks=MappingProxyType(
         {
-            "bounce": PairRecord(reference=27.9, warp_peaks=(10, 62), script=SHADOW_BOUNCE),
-            "baoding": PairRecord(reference=7.31, warp_peaks=(12, 65)),
+            "bounce": PairRecord(
+                reference=27.9, warp_peaks=(10, 62), recipe="bounce_cpu_quickstart", script=SHADOW_BOUNCE
+            ),
+            "baoding": PairRecord(reference=7.31, warp_peaks=(12, 65), recipe="baoding_cpu_shadow"),
         }
     ),
 )

@@ -173,8 +173,10 @@ SHADOW_LITE = RobotSpec(
     excluded_contacts=tuple((_j("palm"), _j(b)) for b in ("ffknuckle", "mfknuckle", "rfknuckle", "thbase")),
     tasks=MappingProxyType(
         {
-            "bounce": PairRecord(reference=9.5, warp_peaks=(8, 53), script=SHADOW_LITE_BOUNCE),
-            "baoding": PairRecord(reference=5.5, warp_peaks=(9, 48)),
+            "bounce": PairRecord(
+                reference=9.5, warp_peaks=(8, 53), recipe="bounce_cpu_quickstart", script=SHADOW_LITE_BOUNCE
+            ),
+            "baoding": PairRecord(reference=5.5, warp_peaks=(9, 48), recipe="baoding_cpu_shadow_lite"),
         }
     ),
 )

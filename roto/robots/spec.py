@@ -49,11 +49,14 @@ class PairRecord:
         warp_peaks: the most contacts and constraint rows any world needed
             (``benchmarks/contact_peaks.py``); the Warp backend sizes its buffers from them
             (``roto.envs.capacity``).
+        recipe: the packaged agent config (``roto/configs/<recipe>.yaml``, training aids included)
+            that trains this pair's baseline on a 2-core CPU: what a plan's ``{recipe}`` names.
         script: Bounce: the scripted motion whose bounces are ``reference`` (``roto.scripted``).
     """
 
     reference: float
     warp_peaks: tuple[int, int]
+    recipe: str
     script: BounceScript | None = None
 
 

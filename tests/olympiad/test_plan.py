@@ -6,6 +6,7 @@ import pytest
 from roto.envs.replay_starts import packaged_banks
 from roto.olympiad.plan import Cell, load_plan, packaged_plans
 from roto.rl.config import load_agent_config
+from roto.robots import ROBOTS
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
@@ -40,10 +41,11 @@ def test_packaged_plans():
         for s in (0, 1)
     }
     assert [c.seed for c in cpu.cells] == sorted(c.seed for c in cpu.cells)  # every first seed before a second
-    for robot in ("shadow", "shadow_lite", "allegro", "orca"):  # each hand's own swept Bounce config
-        assert cpu.variants["ppo"].agent_for("bounce", robot) == (f"bounce_cpu_{robot}", [])
-    shadow, orca = (load_agent_config("bounce", f"bounce_cpu_{r}") for r in ("shadow", "orca"))
-    assert shadow == load_agent_config("bounce", "bounce_cpu_quickstart") and orca.ppo.lr != shadow.ppo.lr
+    recipes = {robot: cpu.variants["ppo"].agent_for("bounce", robot)[0] for robot in ROBOTS}  # each hand's record's
+    quickstart = {robot: "bounce_cpu_quickstart" for robot in ("shadow", "shadow_lite", "allegro")}
+    assert recipes == {**quickstart, "orca": "bounce_cpu_orca"}
+    shadow, orca = (load_agent_config("bounce", recipes[r]) for r in ("shadow", "orca"))
+    assert orca.ppo.lr != shadow.ppo.lr
     long = load_plan("bounce_long_shadow")
     assert [c.name for c in long.cells] == [f"bounce-shadow-blind-quickstart-seed{s}" for s in (0, 1)]
     assert long.steps == 20_000_000 and long.variants["quickstart"].agent_for("bounce") == ("bounce_cpu_quickstart", [])
@@ -264,7 +266,7 @@ def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(plan_nam
 
     plan = load_plan(plan_name)
     cell = cell_spec(plan, Cell("baoding", robot, "blind", variant, 0))
-    config = f"baoding_cpu_{robot}"
+    config = ROBOTS[robot].tasks["baoding"].recipe
     packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=1)
     assert packaged.differences(cell) == {} and packaged.env.aids.replayed_starts.bank == f"{robot}_preswap"
 
