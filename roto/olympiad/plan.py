@@ -67,7 +67,8 @@ class VariantTask:
     def label(self) -> str:
         """The agent config and overrides, as a results table names them."""
         changes = f" + {', '.join(self.overrides)}" if self.overrides else ""
-        return f"{self.agent_cfg or self.task}{changes}"
+        config = "each hand's recipe (its record's)" if self.agent_cfg == RECIPE_FIELD else self.agent_cfg
+        return f"{config or self.task}{changes}"
 
 
 @dataclass(frozen=True)
