@@ -14,7 +14,6 @@ default pose for 10 s, counting the pairs it loses.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import itertools
 import json
 import pathlib
@@ -28,16 +27,16 @@ from roto.reference.baoding_controller import BaodingReference, reference_env, r
 from roto.reference.baoding_cost import BaodingCostWeights
 from roto.reference.hold import run_hold
 from roto.reference.predictive_sampling import PredictiveSampling, SamplingConfig
-from roto.robots.spec import RobotSpec, diagonal_stack, side_by_side
+from roto.robots.spec import RobotSpec, diagonal_stack, side_by_side, with_baoding_geometry
 from roto.sim.scene import build_scene
-from roto.tasks.baoding import MAX_SEPARATION, RESET_NOISE, baoding_balls, drop_positions
+from roto.tasks.baoding import MAX_SEPARATION, RESET_NOISE, baoding_balls, drop_positions, geometry_of
 from roto.tasks.base import PALM_DROP_LIMIT
 
 
 def candidates(robot: RobotSpec) -> dict[str, tuple]:
     """Name -> targets: the four diagonal stacks δ·(±1, ±1, 1) on T_palm, and on the Allegro the two
     side-by-side pairs across the fingers."""
-    t_palm, radius = robot.baoding_targets[0], robot.baoding_ball_radius
+    t_palm, radius = geometry_of(robot).targets[0], geometry_of(robot).ball_radius
     out = {
         f"diagonal ({sx:+.0f}, {sy:+.0f}, +1)": diagonal_stack(t_palm, radius, (sx, sy, 1.0))
         for sx, sy in itertools.product((1.0, -1.0), (1.0, -1.0))
@@ -50,10 +49,10 @@ def candidates(robot: RobotSpec) -> dict[str, tuple]:
 
 def target_depth(robot: RobotSpec) -> float:
     """Deepest contact (m) of a ball with the hand at the default pose, balls on their targets."""
-    model, layout = build_scene(robot, baoding_balls(robot.baoding_ball_radius))
+    model, layout = build_scene(robot, baoding_balls(geometry_of(robot).ball_radius))
     data = mujoco.MjData(model)
     data.qpos[:] = layout.default_qpos
-    for adr, target in zip(layout.ball_qpos, robot.baoding_targets, strict=True):
+    for adr, target in zip(layout.ball_qpos, geometry_of(robot).targets, strict=True):
         data.qpos[adr : adr + 3] = target
     mujoco.mj_forward(model, data)
     balls = {model.body(name).id for name in ("ball_a", "ball_b")}
@@ -68,9 +67,9 @@ def target_depth(robot: RobotSpec) -> float:
 def lost_drops(robot: RobotSpec, centre: tuple[float, float, float], drops: int = 12) -> int:
     """Of ``drops`` pairs dropped about ``centre`` (+ one shared U(±5 mm)³ offset each) onto the hand
     holding its default pose for 600 control steps, how many end the episode (parted or fallen)."""
-    model, layout = build_scene(robot, baoding_balls(robot.baoding_ball_radius))
+    model, layout = build_scene(robot, baoding_balls(geometry_of(robot).ball_radius))
     rng = np.random.default_rng(0)
-    start = drop_positions(torch.tensor(centre, dtype=torch.float64), robot.baoding_ball_radius).numpy()
+    start = drop_positions(torch.tensor(centre, dtype=torch.float64), geometry_of(robot).ball_radius).numpy()
     lost = 0
     for _ in range(drops):
         data = mujoco.MjData(model)
@@ -90,11 +89,11 @@ def lost_drops(robot: RobotSpec, centre: tuple[float, float, float], drops: int 
 
 def drops_row(name: str) -> dict:
     robot = robots.ROBOTS[name]
-    palm_centre = (0.0, 0.0, robot.baoding_drop_centre[2])
+    palm_centre = (0.0, 0.0, geometry_of(robot).drop_centre[2])
     row = {
         "robot": name,
-        "drop_centre": list(robot.baoding_drop_centre),
-        "lost_of_12_at_drop_centre": lost_drops(robot, robot.baoding_drop_centre),
+        "drop_centre": list(geometry_of(robot).drop_centre),
+        "lost_of_12_at_drop_centre": lost_drops(robot, geometry_of(robot).drop_centre),
         "lost_of_12_above_palm_centre": lost_drops(robot, palm_centre),
     }
     print(json.dumps(row), flush=True)
@@ -106,7 +105,7 @@ def measure(name: str, steps: int) -> list[dict]:
     rows = []
     try:
         for label, targets in candidates(base).items():
-            robot = dataclasses.replace(base, baoding_targets=targets)
+            robot = with_baoding_geometry(base, targets=targets)
             robots.ROBOTS[name] = robot
             hold = run_hold("baoding", name, num_envs=16, seed=0)
             env = reference_env(name, seed=0, episode_steps=steps)
@@ -118,7 +117,7 @@ def measure(name: str, steps: int) -> list[dict]:
             row = {
                 "robot": name,
                 "placement": label,
-                "chosen": targets == base.baoding_targets,
+                "chosen": targets == geometry_of(base).targets,
                 "targets": np.round(np.array(targets), 4).tolist(),
                 "target_depth_mm": round(1000 * target_depth(robot), 1),
                 "hold_return": round(hold["mean_return"], 1),

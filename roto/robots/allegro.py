@@ -17,7 +17,7 @@ from types import MappingProxyType
 import mujoco
 import numpy as np
 
-from roto.robots.spec import BounceScript, Gains, PairRecord, RobotSpec, side_by_side
+from roto.robots.spec import BaodingGeometry, BounceScript, Gains, PairRecord, RobotSpec, side_by_side
 
 _BAODING_RADIUS = 0.5 * 2.0 * 0.0254
 
@@ -243,16 +243,22 @@ ALLEGRO = RobotSpec(
     knuckle_bodies=("ff_base", "mf_base", "rf_base"),
     tip_bodies=("ff_tip", "mf_tip", "rf_tip"),
     thumb_tip="th_tip",
-    baoding_ball_radius=_BAODING_RADIUS,
-    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's Allegro variant, the
-    # second target beside it, 2r + 5 mm away across the fingers (towards the index finger)
-    baoding_targets=side_by_side((0.0589, 0.0, 0.0217), _BAODING_RADIUS, (0.0, -1.0, 0.0)),
     tasks=MappingProxyType(
         {
             "bounce": PairRecord(
                 reference=11.8, warp_peaks=(23, 92), recipe="bounce_cpu_quickstart", script=ALLEGRO_BOUNCE
             ),
-            "baoding": PairRecord(reference=5.03, warp_peaks=(24, 96), recipe="baoding_cpu_allegro"),
+            "baoding": PairRecord(
+                reference=5.03,
+                warp_peaks=(24, 96),
+                recipe="baoding_cpu_allegro",
+                geometry=BaodingGeometry(
+                    ball_radius=_BAODING_RADIUS,
+                    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's Allegro variant, the
+                    # second target beside it, 2r + 5 mm away across the fingers (towards the index finger)
+                    targets=side_by_side((0.0589, 0.0, 0.0217), _BAODING_RADIUS, (0.0, -1.0, 0.0)),
+                ),
+            ),
         }
     ),
 )

@@ -15,7 +15,7 @@ from types import MappingProxyType
 import mujoco
 import numpy as np
 
-from roto.robots.spec import BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
+from roto.robots.spec import BaodingGeometry, BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.5 * 0.0254
 
@@ -141,12 +141,6 @@ ORCA = RobotSpec(
     knuckle_bodies=tuple(_j(f"{f}_mp") for f in _FINGERS),
     tip_bodies=tuple(_j(f"{f}_ip") for f in _FINGERS),
     thumb_tip=_j("thumb_dp"),
-    baoding_ball_radius=_BAODING_RADIUS,
-    # T_palm: where the dropped ball a comes to rest (rest_after_drop); the stack δ·(1, 1, 1) above it,
-    # not roto's ORCA variant δ·(-1, 1, 1), where holding still swaps about once an episode (docs/tasks.md)
-    baoding_targets=diagonal_stack((0.0777, -0.0021, -0.0229), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
-    # above the finger pocket: dropped above the palm centre, 9 of 12 pairs fell off (docs/tasks.md)
-    baoding_drop_centre=(0.073, 0.017, 0.09),
     # The bounding boxes are fuller than the meshes: the palm box reaches the fingers' first links.
     excluded_contacts=(
         *((_j("palm"), _j(f"{f}_{link}")) for f in (*_FINGERS, "thumb") for link in ("pp", "ip")),
@@ -155,7 +149,21 @@ ORCA = RobotSpec(
     tasks=MappingProxyType(
         {
             "bounce": PairRecord(reference=12.0, warp_peaks=(63, 270), recipe="bounce_cpu_orca", script=ORCA_BOUNCE),
-            "baoding": PairRecord(reference=5.78, warp_peaks=(65, 277), recipe="baoding_cpu_orca"),
+            "baoding": PairRecord(
+                reference=5.78,
+                warp_peaks=(65, 277),
+                recipe="baoding_cpu_orca",
+                geometry=BaodingGeometry(
+                    ball_radius=_BAODING_RADIUS,
+                    # T_palm: where the dropped ball a comes to rest (rest_after_drop); the stack δ·(1, 1, 1)
+                    # above it, not roto's ORCA variant δ·(-1, 1, 1), where holding still swaps about once
+                    # an episode (docs/tasks.md)
+                    targets=diagonal_stack((0.0777, -0.0021, -0.0229), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
+                    # above the finger pocket: dropped above the palm centre, 9 of 12 pairs fell off
+                    # (docs/tasks.md)
+                    drop_centre=(0.073, 0.017, 0.09),
+                ),
+            ),
         }
     ),
 )

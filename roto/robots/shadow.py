@@ -13,7 +13,7 @@ from types import MappingProxyType
 
 import mujoco
 
-from roto.robots.spec import BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
+from roto.robots.spec import BaodingGeometry, BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.5 * 0.0254
 
@@ -125,15 +125,22 @@ SHADOW = RobotSpec(
     knuckle_bodies=tuple(_j(f"{f}knuckle") for f in ("ff", "mf", "rf", "lf")),
     tip_bodies=tuple(_j(f"{f}distal") for f in ("ff", "mf", "rf", "lf")),
     thumb_tip=_j("thdistal"),
-    baoding_ball_radius=_BAODING_RADIUS,
-    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack δ·(1, 1, 1) above it
-    baoding_targets=diagonal_stack((0.0577, -0.0079, -0.0066), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
     tasks=MappingProxyType(
         {
             "bounce": PairRecord(
                 reference=27.9, warp_peaks=(10, 62), recipe="bounce_cpu_quickstart", script=SHADOW_BOUNCE
             ),
-            "baoding": PairRecord(reference=7.31, warp_peaks=(12, 65), recipe="baoding_cpu_shadow"),
+            "baoding": PairRecord(
+                reference=7.31,
+                warp_peaks=(12, 65),
+                recipe="baoding_cpu_shadow",
+                geometry=BaodingGeometry(
+                    ball_radius=_BAODING_RADIUS,
+                    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack
+                    # δ·(1, 1, 1) above it
+                    targets=diagonal_stack((0.0577, -0.0079, -0.0066), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
+                ),
+            ),
         }
     ),
 )

@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 
 from roto.robots.shadow import load_shadow_spec
-from roto.robots.spec import BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
+from roto.robots.spec import BaodingGeometry, BounceScript, Gains, PairRecord, RobotSpec, diagonal_stack
 
 _BAODING_RADIUS = 0.5 * 1.2 * 0.0254
 
@@ -165,18 +165,26 @@ SHADOW_LITE = RobotSpec(
     knuckle_bodies=tuple(_j(f"{f}knuckle") for f in _FINGERS),
     tip_bodies=tuple(_j(f"{f}distal") for f in _FINGERS),
     thumb_tip=_j("thdistal"),
-    baoding_ball_radius=_BAODING_RADIUS,
-    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack δ·(1, 1, 1) above it
-    baoding_targets=diagonal_stack((0.0559, -0.0106, 0.0068), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
-    # above the finger pocket: dropped above the palm centre, 12 of 12 pairs fell off (docs/tasks.md)
-    baoding_drop_centre=(0.041, -0.014, 0.09),
     excluded_contacts=tuple((_j("palm"), _j(b)) for b in ("ffknuckle", "mfknuckle", "rfknuckle", "thbase")),
     tasks=MappingProxyType(
         {
             "bounce": PairRecord(
                 reference=9.5, warp_peaks=(8, 53), recipe="bounce_cpu_quickstart", script=SHADOW_LITE_BOUNCE
             ),
-            "baoding": PairRecord(reference=5.5, warp_peaks=(9, 48), recipe="baoding_cpu_shadow_lite"),
+            "baoding": PairRecord(
+                reference=5.5,
+                warp_peaks=(9, 48),
+                recipe="baoding_cpu_shadow_lite",
+                geometry=BaodingGeometry(
+                    ball_radius=_BAODING_RADIUS,
+                    # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack
+                    # δ·(1, 1, 1) above it
+                    targets=diagonal_stack((0.0559, -0.0106, 0.0068), _BAODING_RADIUS, (1.0, 1.0, 1.0)),
+                    # above the finger pocket: dropped above the palm centre, 12 of 12 pairs fell off
+                    # (docs/tasks.md)
+                    drop_centre=(0.041, -0.014, 0.09),
+                ),
+            ),
         }
     ),
 )

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
 
 import mujoco
 
@@ -40,6 +43,23 @@ class BounceScript:
 
 
 @dataclass(frozen=True, kw_only=True)
+class BaodingGeometry:
+    """Where Baoding's balls and targets go on one hand (docs/tasks.md).
+
+    Attributes:
+        ball_radius: the balls' radius on this hand (m).
+        targets: T_a and T_b (task frame, m): roto's diagonal stack (``diagonal_stack``) or
+            side-by-side pair (``side_by_side``) placed in this hand's cupped pose.
+        drop_centre: midpoint (task frame, m) of the two balls when they are dropped at an episode
+            start (each 2 cm from it along the fingers).
+    """
+
+    ball_radius: float
+    targets: tuple[tuple[float, float, float], tuple[float, float, float]]
+    drop_centre: tuple[float, float, float] = (0.0, 0.0, 0.09)
+
+
+@dataclass(frozen=True, kw_only=True)
 class PairRecord:
     """What belongs to one (task, hand) pair, measured on that hand (docs/robots.md).
 
@@ -52,12 +72,14 @@ class PairRecord:
         recipe: the packaged agent config (``roto/configs/<recipe>.yaml``, training aids included)
             that trains this pair's baseline on a 2-core CPU: what a plan's ``{recipe}`` names.
         script: Bounce: the scripted motion whose bounces are ``reference`` (``roto.scripted``).
+        geometry: Baoding: where its balls and targets go on this hand.
     """
 
     reference: float
     warp_peaks: tuple[int, int]
     recipe: str
     script: BounceScript | None = None
+    geometry: BaodingGeometry | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -80,11 +102,6 @@ class RobotSpec:
         tasks: task name -> the pair's record (``PairRecord``): what was measured of this hand on
             that task.
         thumb_tip: the thumb's distal body (with ``tip_bodies`` and the palm: where taxels lie).
-        baoding_ball_radius: Baoding ball radius for this hand (m).
-        baoding_targets: T_a and T_b (task frame, m): roto's diagonal stack (``diagonal_stack``) or
-            side-by-side pair (``side_by_side``) placed in this hand's cupped pose (docs/tasks.md).
-        baoding_drop_centre: midpoint (task frame, m) of the two Baoding balls when they are
-            dropped at an episode start (each 2 cm from it along the fingers).
         coupled_joints: driven joint -> (driving joint, ratio): the model couples them (tendon or
             equality); resets set driven = ratio * driving so no coupling starts violated.
         excluded_contacts: body pairs whose contacts are filtered out.
@@ -107,9 +124,6 @@ class RobotSpec:
     knuckle_bodies: tuple[str, ...]
     tip_bodies: tuple[str, ...]
     thumb_tip: str
-    baoding_ball_radius: float
-    baoding_targets: tuple[tuple[float, float, float], tuple[float, float, float]]
-    baoding_drop_centre: tuple[float, float, float] = (0.0, 0.0, 0.09)
     coupled_joints: Mapping[str, tuple[str, float]] = field(default_factory=dict)
     excluded_contacts: tuple[tuple[str, str], ...] = field(default=())
     palm_tilt: tuple[float, float] = (0.0, 0.0)
@@ -148,3 +162,12 @@ def side_by_side(palm: Point, radius: float, direction: Point) -> tuple[Point, P
     norm = sum(d * d for d in direction) ** 0.5
     spacing = 2.0 * radius + SIDE_BY_SIDE_GAP
     return tuple(palm), tuple(p + spacing * d / norm for p, d in zip(palm, direction, strict=True))
+
+
+def with_baoding_geometry(robot: RobotSpec, **changes: Any) -> RobotSpec:
+    """``robot`` with its Baoding geometry changed (``BaodingGeometry`` fields: ``targets`` ...): a
+    candidate placement to try (``benchmarks/baoding_placements.py``), or a broken one to refuse."""
+    record = robot.tasks["baoding"]
+    geometry = dataclasses.replace(record.geometry, **changes)
+    tasks = MappingProxyType({**robot.tasks, "baoding": dataclasses.replace(record, geometry=geometry)})
+    return dataclasses.replace(robot, tasks=tasks)

@@ -11,7 +11,7 @@ import numpy as np
 import torch
 
 from roto.robots import pair_references
-from roto.robots.spec import RobotSpec
+from roto.robots.spec import BaodingGeometry, RobotSpec
 from roto.sim.scene import BallSpec, build_scene
 from roto.tasks.arrays import Array, as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where, zero_on_host
 from roto.tasks.base import (
@@ -66,15 +66,28 @@ def drop_positions(centre: torch.Tensor, radius: float) -> torch.Tensor:
     return torch.stack([centre + half, centre - half])
 
 
+def geometry_of(robot: RobotSpec) -> BaodingGeometry:
+    """The robot's Baoding geometry, from its record of the pair (``PairRecord.geometry``).
+
+    Raises:
+        ValueError naming the robot when its record has none.
+    """
+    record = robot.tasks.get("baoding")
+    if record is None or record.geometry is None:
+        raise ValueError(f"robot {robot.name!r} has no Baoding geometry in its record (tasks['baoding'].geometry)")
+    return record.geometry
+
+
 def rest_after_drop(robot: RobotSpec, settle_steps: int = 600, substeps: int = 4) -> np.ndarray:
     """Where the two balls come to rest (2, 3), task frame, when dropped from the robot's drop
     positions (no offset) onto the hand holding its default pose for ``settle_steps`` control
     steps. Ball a's resting place is the hand's T_palm (docs/tasks.md)."""
-    radius = robot.baoding_ball_radius
+    geometry = geometry_of(robot)
+    radius = geometry.ball_radius
     model, layout = build_scene(robot, baoding_balls(radius))
     data = mujoco.MjData(model)
     data.qpos[:] = layout.default_qpos
-    drop = drop_positions(torch.tensor(robot.baoding_drop_centre, dtype=torch.float64), radius).numpy()
+    drop = drop_positions(torch.tensor(geometry.drop_centre, dtype=torch.float64), radius).numpy()
     for adr, start in zip(layout.ball_qpos, drop, strict=True):
         data.qpos[adr : adr + 3] = start
     data.ctrl[:] = layout.default_qpos[layout.act_qpos]
@@ -89,8 +102,9 @@ def check_setup(robot: RobotSpec) -> None:
         ValueError naming the hand and the distances. (Whether the drop starts the balls clear of
         the hand is checked where the env is made, and on every start: ``roto.envs.start_pool``.)
     """
-    radius = robot.baoding_ball_radius
-    t_a, t_b = np.asarray(robot.baoding_targets, dtype=np.float64)
+    geometry = geometry_of(robot)
+    radius = geometry.ball_radius
+    t_a, t_b = np.asarray(geometry.targets, dtype=np.float64)
     gap = float(np.linalg.norm(t_a - t_b))
     if gap < 2.0 * radius:
         raise ValueError(
@@ -192,16 +206,17 @@ class Baoding:
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """Two 55 g balls of the robot's Baoding diameter."""
-        return baoding_balls(robot.baoding_ball_radius)
+        return baoding_balls(geometry_of(robot).ball_radius)
 
     def init_state(self, robot: RobotSpec, num_envs: int, device: torch.device) -> BaodingState:
         """Targets and drop from the robot record; latches clear."""
         check_setup(robot)
-        targets = torch.tensor(robot.baoding_targets, dtype=torch.float64, device=device)
-        centre = torch.tensor(robot.baoding_drop_centre, dtype=torch.float64, device=device)
+        geometry = geometry_of(robot)
+        targets = torch.tensor(geometry.targets, dtype=torch.float64, device=device)
+        centre = torch.tensor(geometry.drop_centre, dtype=torch.float64, device=device)
         return BaodingState(
             targets=targets,
-            drop=drop_positions(centre, robot.baoding_ball_radius),
+            drop=drop_positions(centre, geometry.ball_radius),
             swapped=torch.zeros(num_envs, dtype=torch.bool, device=device),
             latched=torch.zeros(num_envs, 2, dtype=torch.bool, device=device),
             swaps=torch.zeros(num_envs, dtype=torch.int64, device=device),

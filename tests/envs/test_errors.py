@@ -2,6 +2,7 @@ import pytest
 import torch
 
 import roto
+from roto.robots.spec import with_baoding_geometry
 from tests.conftest import make_env
 
 
@@ -80,11 +81,10 @@ def test_step_never_modifies_the_callers_action(env):
 
 def test_a_baoding_drop_inside_the_hand_is_refused_when_the_env_is_made(monkeypatch):
     """Balls 'dropped' from the palm surface start half inside it: the env refuses, naming the hand and depth."""
-    import dataclasses
 
     import roto.robots as robots
 
-    sunk = dataclasses.replace(robots.ROBOTS["shadow"], baoding_drop_centre=(0.0, 0.0, 0.0))
+    sunk = with_baoding_geometry(robots.ROBOTS["shadow"], drop_centre=(0.0, 0.0, 0.0))
     monkeypatch.setitem(robots.ROBOTS, "shadow", sunk)
     with pytest.raises(ValueError, match=r"robot 'shadow', task 'baoding': the balls start [0-9.]+-[0-9.]+ mm deep"):
         roto.make("baoding", robot="shadow")

@@ -8,6 +8,7 @@ import torch
 
 from roto.envs.start_pool import MAX_BALL_START_PENETRATION, MAX_DRAW_ROUNDS, draw_valid_starts
 from roto.robots import ROBOTS
+from roto.tasks.baoding import geometry_of
 from tests.conftest import make_env, require_warp
 
 
@@ -84,7 +85,7 @@ def test_the_ball_check_rejects_a_ball_started_in_the_hand():
     candidates = env.starts.candidates(8)
     assert float(candidates["ball_penetration"].max()) == 0.0  # dropped from above: clear
     qpos = candidates["qpos"].clone()
-    rest = torch.tensor(env.robot.baoding_targets[0], dtype=torch.float64)  # where ball a rests on the hand
+    rest = torch.tensor(geometry_of(env.robot).targets[0], dtype=torch.float64)  # where ball a rests on the hand
     qpos[:, env.layout.ball_qpos[0] : env.layout.ball_qpos[0] + 3] = rest - torch.tensor([0.0, 0.0, 0.015])
     sensors = env.backend.sensors_at(qpos, torch.zeros(8, env.model.nv, dtype=torch.float64), candidates["target"])
     found, dist = env.indices.ball_clearance.take(sensors.to(torch.float64)).unbind(-1)

@@ -8,7 +8,7 @@ import roto
 from roto.robots import ROBOTS, get_robot
 from roto.robots.mjspec_tools import palm_frame, tilt_rotation
 from roto.sim.scene import build_scene
-from roto.tasks.baoding import rest_after_drop
+from roto.tasks.baoding import geometry_of, rest_after_drop
 
 # docs/spec.md §3: hand joints, actions, tactile links, blind frame size
 TABLE = {
@@ -61,9 +61,9 @@ def test_no_tactile_bit_without_objects_in_the_default_pose(name):
 def test_baoding_palm_target_is_where_the_dropped_ball_a_comes_to_rest(name):
     robot = get_robot(name)
     rest = rest_after_drop(robot)
-    np.testing.assert_allclose(rest[0], np.array(robot.baoding_targets[0]), atol=2e-3)
-    gap = np.linalg.norm(np.subtract(*robot.baoding_targets))
-    assert gap >= 2 * robot.baoding_ball_radius  # balls on their targets never overlap
+    np.testing.assert_allclose(rest[0], np.array(geometry_of(robot).targets[0]), atol=2e-3)
+    gap = np.linalg.norm(np.subtract(*geometry_of(robot).targets))
+    assert gap >= 2 * geometry_of(robot).ball_radius  # balls on their targets never overlap
 
 
 def test_shadow_lite_is_the_shadow_cut_down():
@@ -71,7 +71,7 @@ def test_shadow_lite_is_the_shadow_cut_down():
     model, _ = build_scene(lite, ())
     names = {model.joint(j).name for j in range(model.njnt)}
     assert not any(("LF" in n) or ("WRJ" in n) or n.endswith("THJ2") for n in names)
-    assert lite.baoding_ball_radius == pytest.approx(0.5 * 1.2 * 0.0254)
+    assert geometry_of(lite).ball_radius == pytest.approx(0.5 * 1.2 * 0.0254)
     # distal joints follow their middle joints 1:1 through the tendon
     data = mujoco.MjData(model)
     idx = [model.joint(f"robot0:FFJ{k}").qposadr[0] for k in (1, 0)]

@@ -5,6 +5,7 @@ import pytest
 from roto.robots import get_robot
 from roto.robots.mjspec_tools import palm_frame
 from roto.sim.scene import BallSpec, build_scene
+from roto.tasks.baoding import geometry_of
 
 SHADOW = get_robot("shadow")
 
@@ -53,8 +54,8 @@ def test_no_tactile_bit_in_the_default_pose_without_objects():
 
 def test_baoding_targets_are_roto_s_diagonal_stack():
     """T_diag = T_palm + δ·(1, 1, 1), δ = 2r/√3 + 1 mm: one target 23 mm above the other."""
-    t_palm, t_diag = np.array(SHADOW.baoding_targets)
-    delta = 2 * SHADOW.baoding_ball_radius / np.sqrt(3) + 0.001
+    t_palm, t_diag = np.array(geometry_of(SHADOW).targets)
+    delta = 2 * geometry_of(SHADOW).ball_radius / np.sqrt(3) + 0.001
     np.testing.assert_allclose(t_diag - t_palm, delta * np.ones(3), atol=1e-12)
     assert t_diag[2] - t_palm[2] == pytest.approx(0.0230, abs=1e-4)
 

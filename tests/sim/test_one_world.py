@@ -12,7 +12,7 @@ from roto.robots import get_robot
 from roto.sim.mujoco_cpu import MujocoCpuBackend
 from roto.sim.one_world import OneWorldStep
 from roto.sim.scene import build_scene
-from roto.tasks.baoding import baoding_balls
+from roto.tasks.baoding import baoding_balls, geometry_of
 
 _FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS.value
 _CTRL = mujoco.mjtState.mjSTATE_CTRL.value
@@ -25,7 +25,7 @@ REST = ((0.0577, -0.0079, -0.0066), (0.0243, 0.0073, 0.0028))
 def scene():
     """Shadow holding two Baoding balls just above the palm (contacts from the first steps)."""
     robot = get_robot("shadow")
-    model, layout = build_scene(robot, baoding_balls(robot.baoding_ball_radius))
+    model, layout = build_scene(robot, baoding_balls(geometry_of(robot).ball_radius))
     data = mujoco.MjData(model)
     data.qpos[:] = layout.default_qpos
     for adr, rest in zip(layout.ball_qpos, REST, strict=True):

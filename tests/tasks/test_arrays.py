@@ -9,6 +9,7 @@ import torch
 from roto.robots import get_robot
 from roto.tasks import get_task
 from roto.tasks.arrays import as_dtype_of, flip_rows, squared_norm, tanh, vector_norm, where
+from roto.tasks.baoding import geometry_of
 from roto.tasks.base import TaskInputs
 
 B = 4000
@@ -48,7 +49,7 @@ def test_tanh_where_and_dtype_give_the_same_bits():
 def random_inputs(task_name, robot, rng):
     """Ball states near the task's targets (latches, swaps, drops and ends all occur) and contacts."""
     n_ball = 2 if task_name == "baoding" else 1
-    centre = np.asarray(robot.baoding_targets) if task_name == "baoding" else np.array([[0.0, 0.0, 0.05]])
+    centre = np.asarray(geometry_of(robot).targets) if task_name == "baoding" else np.array([[0.0, 0.0, 0.05]])
     pos = centre[None] + rng.normal(size=(B, n_ball, 3)) * rng.choice([0.004, 0.1], size=(B, 1, 1))
     return TaskInputs(pos, rng.normal(size=(B, n_ball, 3)), rng.random((B, n_ball)) < 0.5)
 

@@ -1,14 +1,13 @@
-import dataclasses
-
 import pytest
 import torch
 
 from roto.robots import get_robot
-from roto.tasks.baoding import DROP_SPACING, RESET_NOISE, Baoding, baoding_rule, drop_spacing
+from roto.robots.spec import with_baoding_geometry
+from roto.tasks.baoding import DROP_SPACING, RESET_NOISE, Baoding, baoding_rule, drop_spacing, geometry_of
 from roto.tasks.base import TaskInputs
 
 SHADOW = get_robot("shadow")
-TARGETS = torch.tensor(SHADOW.baoding_targets, dtype=torch.float64)
+TARGETS = torch.tensor(geometry_of(SHADOW).targets, dtype=torch.float64)
 
 
 def _inputs(pos_a, pos_b) -> TaskInputs:
@@ -71,7 +70,7 @@ def test_reset_clears_state_and_drops_the_balls_side_by_side_from_above():
     assert state.swapped.tolist() == [True, False] and state.swaps.tolist() == [3, 0]
     assert state.latched.tolist() == [[True, True], [False, False]]
     pos = task.initial_ball_positions(state, 64, torch.Generator().manual_seed(0))
-    centre = torch.tensor(SHADOW.baoding_drop_centre, dtype=torch.float64)
+    centre = torch.tensor(geometry_of(SHADOW).drop_centre, dtype=torch.float64)
     half = torch.tensor([[DROP_SPACING / 2, 0, 0], [-DROP_SPACING / 2, 0, 0]], dtype=torch.float64)
     offset = pos - (centre + half)
     assert torch.all(offset.abs() <= RESET_NOISE)
@@ -82,12 +81,12 @@ def test_reset_clears_state_and_drops_the_balls_side_by_side_from_above():
 
 def test_the_allegro_s_larger_balls_are_dropped_a_diameter_and_1mm_apart():
     allegro = get_robot("allegro")
-    assert drop_spacing(allegro.baoding_ball_radius) == pytest.approx(2 * 0.0254 + 0.001)
-    assert drop_spacing(SHADOW.baoding_ball_radius) == DROP_SPACING
+    assert drop_spacing(geometry_of(allegro).ball_radius) == pytest.approx(2 * 0.0254 + 0.001)
+    assert drop_spacing(geometry_of(SHADOW).ball_radius) == DROP_SPACING
 
 
 def test_targets_closer_than_two_radii_are_refused_naming_the_hand_and_distances():
-    t_palm = SHADOW.baoding_targets[0]
-    close = dataclasses.replace(SHADOW, baoding_targets=(t_palm, (t_palm[0] + 0.03, t_palm[1], t_palm[2])))
+    t_palm = geometry_of(SHADOW).targets[0]
+    close = with_baoding_geometry(SHADOW, targets=(t_palm, (t_palm[0] + 0.03, t_palm[1], t_palm[2])))
     with pytest.raises(ValueError, match=r"robot 'shadow': Baoding targets 30\.0 mm apart.*\(38\.1 mm\)"):
         Baoding().init_state(close, 1, torch.device("cpu"))

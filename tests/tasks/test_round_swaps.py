@@ -12,7 +12,7 @@ import roto
 from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
 from roto.robots import get_robot
-from roto.tasks.baoding import SWAP_REWARD, Baoding
+from roto.tasks.baoding import SWAP_REWARD, Baoding, geometry_of
 from roto.tasks.base import TaskInputs
 from roto.tasks.round_swaps import paid_swaps, pair_turn_step
 
@@ -69,7 +69,7 @@ def path_round_the_targets(thetas):
     """(T, 2, 3): the balls on a circle round the targets' midpoint, the line turned by each
     ``theta`` (rad) about the axis nearest the palm's normal (z) perpendicular to it; at theta = pi
     each ball sits on the other's target."""
-    t_a, t_b = torch.tensor(SHADOW.baoding_targets, dtype=torch.float64)
+    t_a, t_b = torch.tensor(geometry_of(SHADOW).targets, dtype=torch.float64)
     mid, half = (t_a + t_b) / 2, (t_b - t_a) / 2
     h = half / half.norm()
     z = torch.tensor([0.0, 0.0, 1.0], dtype=torch.float64)
