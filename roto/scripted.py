@@ -30,10 +30,6 @@ from roto.robots.spec import BounceScript
 HOLD, WIND_UP, STRIKE = 0, 1, 2
 
 
-SCRIPTS: dict[str, BounceScript] = {name: robot.tasks["bounce"].script for name, robot in ROBOTS.items()}
-"""Each hand's scripted Bounce motion, from its record of the pair (``roto/robots/<hand>.py``)."""
-
-
 class ScriptedBounce:
     """The scripted Bounce policy for ``env`` (built with ``obs_mode="state"``: it reads the ball and touch).
 
@@ -41,13 +37,15 @@ class ScriptedBounce:
     """
 
     def __init__(self, env: RotoEnv, script: BounceScript | None = None) -> None:
-        """``script`` defaults to the robot's entry in ``SCRIPTS``."""
+        """``script`` defaults to the robot's, in its record of the pair (``PairRecord.script``)."""
         if "privileged" not in env.groups or "tactile" not in env.groups:
             raise ValueError(f"the scripted policy needs obs_mode='state', got {env.config.obs_mode!r}")
         if script is None:
-            if env.robot.name not in SCRIPTS:
-                raise ValueError(f"no Bounce script for robot {env.robot.name!r}; scripted robots: {sorted(SCRIPTS)}")
-            script = SCRIPTS[env.robot.name]
+            record = env.robot.tasks.get("bounce")
+            if record is None or record.script is None:
+                scripted = sorted(name for name, robot in ROBOTS.items() if robot.tasks["bounce"].script is not None)
+                raise ValueError(f"no Bounce script for robot {env.robot.name!r}; scripted robots: {scripted}")
+            script = record.script
         self.script = script
         idx = env.indices
         self._lo, self._hi = idx.ctrl_lo, idx.ctrl_hi

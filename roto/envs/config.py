@@ -38,7 +38,7 @@ class EnvConfig:
         tactile_threshold: normal force (N) above which a link or a taxel counts as touched.
         reset_joint_noise: half-width (rad) of the uniform noise added to the default pose at reset.
         nconmax: contacts per world the ``warp`` backend allocates (None: roto's measured figure for
-            this robot and task, ``roto.envs.capacity``).
+            this robot and task, ``PairRecord.warp_capacity``).
         njmax: constraint rows per world for ``warp`` (None: as for ``nconmax``).
         aids: the training aids of the training envs (``roto.envs.aids.settings``: replayed
             starts, a tolerance curriculum, round swaps, turn shaping; none by default). A plain

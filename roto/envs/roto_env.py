@@ -20,7 +20,6 @@ import torch
 from roto.envs.aids.aid_set import AidSet
 from roto.envs.aids.build import build_aids
 from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
-from roto.envs.capacity import warp_capacity
 from roto.envs.config import EnvConfig
 from roto.envs.control import action_to_target, smooth_target, target_to_action
 from roto.envs.episode_book import EpisodeBook
@@ -47,7 +46,7 @@ def backend_for(config: EnvConfig, model: mujoco.MjModel) -> Backend:
     constraint buffers are roto's measured figures for the pair unless the config gives them."""
     capacity = {}
     if config.backend == "warp":
-        nconmax, njmax = warp_capacity(config.robot, config.task)
+        nconmax, njmax = get_robot(config.robot).tasks[config.task].warp_capacity
         capacity = {"nconmax": config.nconmax or nconmax, "njmax": config.njmax or njmax}
     return make_backend(
         config.backend,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -68,7 +69,7 @@ class PairRecord:
             reference controller) on this hand, in the task's headline metric per 10 s.
         warp_peaks: the most contacts and constraint rows any world needed
             (``benchmarks/contact_peaks.py``); the Warp backend sizes its buffers from them
-            (``roto.envs.capacity``).
+            (``warp_capacity``).
         recipe: the packaged agent config (``roto/configs/<recipe>.yaml``, training aids included)
             that trains this pair's baseline on a 2-core CPU: what a plan's ``{recipe}`` names.
         script: Bounce: the scripted motion whose bounces are ``reference`` (``roto.scripted``).
@@ -80,6 +81,16 @@ class PairRecord:
     recipe: str
     script: BounceScript | None = None
     geometry: BaodingGeometry | None = None
+
+    @property
+    def warp_capacity(self) -> tuple[int, int]:
+        """(nconmax, njmax) per world the Warp backend allocates for the pair: MuJoCo Warp sizes
+        its contact and constraint-row buffers once, and a world that needs more loses contacts,
+        so the measured peaks (32 worlds x 600 control steps of a random-action and a held-pose
+        workload on the CPU backend) are doubled and rounded up, contacts to a multiple of 16 and
+        rows to one of 32."""
+        ncon, nefc = self.warp_peaks
+        return 16 * math.ceil(2.0 * ncon / 16), 32 * math.ceil(2.0 * nefc / 32)
 
 
 @dataclass(frozen=True, kw_only=True)
