@@ -15,6 +15,7 @@ from roto.rl.build import check_policy_fits
 from roto.rl.networks import ActorCritic
 from roto.rl.run_spec import RunSpec
 from roto.rl.torch_threads import single_torch_thread
+from roto.tasks import get_task
 
 MAX_PARALLEL_ENVS = 128
 
@@ -46,7 +47,8 @@ def evaluate(
         for name, values in result.items():
             per_episode.setdefault(name, []).extend(values)
     summary: dict[str, object] = {"episodes": episodes}
-    for key, values in per_episode.items():
+    lead = get_task(spec.env.task).selection_metric  # Baoding's round rotations first, roto's count after
+    for key, values in sorted(per_episode.items(), key=lambda item: item[0] != lead):
         t = torch.tensor(values, dtype=torch.float64)
         summary[f"{key}_mean"] = float(t.mean())
         summary[f"{key}_std"] = float(t.std(unbiased=False))

@@ -13,6 +13,7 @@ from roto.sweep.command import STORAGE_HELP
 
 if TYPE_CHECKING:
     from roto.olympiad.plan import Plan
+    from roto.tasks.base import Task
 
 
 def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
@@ -116,8 +117,9 @@ def recent_rate(records: list[dict]) -> float | None:
 
 
 def headline_so_far(records: list[dict], metric: str, path_metrics: tuple[str, ...] = ()) -> str:
-    """``; last evaluation X <metric> (<path metric> P, ...), best Y at Z M`` from a run's evaluation
-    records ("" without the metric; each path metric only where the last record has it)."""
+    """``; last evaluation X <metric> (<other measure> P, ...), best Y at Z M`` from a run's
+    evaluation records ("" without the metric; each other measure, ``path_metrics``, only where the
+    last record has it)."""
     scored = [r for r in records if f"{metric}_mean" in r]
     if not scored:
         return ""
@@ -127,6 +129,14 @@ def headline_so_far(records: list[dict], metric: str, path_metrics: tuple[str, .
         f"; last evaluation {last[f'{metric}_mean']:.2f} {metric}{f' ({paths})' if paths else ''}, "
         f"best {best[f'{metric}_mean']:.2f} at {best['env_steps'] / 1e6:.1f} M"
     )
+
+
+def status_metrics(task: Task, records: list[dict]) -> tuple[str, tuple[str, ...]]:
+    """(the measure a run's status leads with, the others beside it): the task's selection metric
+    (Baoding: round rotations, roto's count beside it) where its records have it, else the headline."""
+    measured = task.selection_metric and any(f"{task.selection_metric}_mean" in r for r in records)
+    lead = task.selection_metric if measured else task.headline_metric
+    return lead, tuple(m for m in (task.headline_metric, *task.path_metric_names) if m != lead)
 
 
 def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1) -> str:
@@ -151,7 +161,7 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
             started_rates.append(rate_now)
             if state == "running":
                 running_rates.append(rate_now)
-        so_far = headline_so_far(records, tasks[name].headline_metric, tasks[name].path_metric_names)
+        so_far = headline_so_far(records, *status_metrics(tasks[name], records))
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps{so_far})" if records else ""
         lines.append(f"  {name:<52} {state}{progress}")
     left = sum(state != "done" for state in status.values())

@@ -421,3 +421,13 @@ def test_the_dry_run_line_shows_the_last_evaluations_path_metrics_where_it_has_t
     line = headline_so_far(rounds, "rotations", names)
     assert line == "; last evaluation 5.50 rotations (net_turns 0.25, travelled_turns 3.50), best 6.00 at 1.0 M"
     assert headline_so_far(rounds[:1], "rotations", names) == "; last evaluation 6.00 rotations, best 6.00 at 1.0 M"
+    from roto.olympiad.command import status_metrics
+    from roto.tasks import get_task
+
+    baoding = get_task("baoding")
+    assert status_metrics(baoding, rounds) == ("rotations", ("net_turns", "travelled_turns", "round_rotations"))
+    measured = [{**rounds[1], "round_rotations_mean": 0.25}]  # Baoding leads with round rotations where measured
+    assert status_metrics(baoding, measured) == ("round_rotations", ("rotations", "net_turns", "travelled_turns"))
+    assert headline_so_far(measured, *status_metrics(baoding, measured)).startswith(
+        "; last evaluation 0.25 round_rotations (rotations 5.50, net_turns 0.25, travelled_turns 3.50)"
+    )
