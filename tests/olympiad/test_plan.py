@@ -13,6 +13,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 def test_packaged_plans():
     assert set(packaged_plans()) == {
+        "benchmark",
         "cpu",
         "paper",
         "variants_bounce",
@@ -431,3 +432,14 @@ def test_the_dry_run_line_shows_the_last_evaluations_path_metrics_where_it_has_t
     assert headline_so_far(measured, *status_metrics(baoding, measured)).startswith(
         "; last evaluation 0.25 round_rotations (rotations 5.50, net_turns 0.25, travelled_turns 3.50)"
     )
+
+
+def test_the_benchmark_plan_trains_every_hand_and_mode_with_its_record_s_recipe_on_three_seeds():
+    from roto.olympiad.cell import cell_spec
+
+    plan, cpu = load_plan("benchmark"), load_plan("cpu")
+    assert {(c.robot, c.obs, c.seed) for c in plan.cells} == {
+        (robot, obs, seed) for robot in ROBOTS for obs in ("blind", "state", "proprio") for seed in (0, 1, 2)
+    }
+    shared = [c for c in plan.cells if c in set(cpu.cells)]  # the cpu plan's Bounce cells, same names
+    assert len(shared) == 24 and all(cell_spec(plan, c).differences(cell_spec(cpu, c)) == {} for c in shared)
