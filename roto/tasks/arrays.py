@@ -74,6 +74,13 @@ def atan2(y: Array, x: Array) -> Array:
     return torch.atan2(y, x)
 
 
+def minimum(x: Array, y: Array | float) -> Array:
+    """Elementwise smaller of ``x`` and ``y`` (an array of ``x``'s kind or a number)."""
+    if isinstance(x, np.ndarray):
+        return np.minimum(x, y)
+    return torch.minimum(x, torch.as_tensor(y, dtype=x.dtype, device=x.device))
+
+
 def zero_on_host(x: Array) -> bool:
     """Whether ``x`` is zero everywhere, where reading it costs nothing: a numpy array or a CPU
     tensor. A tensor on another device is never read (that would wait for the device): False, so

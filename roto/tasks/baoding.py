@@ -30,6 +30,8 @@ BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
 """A ball within this distance of its current target sets its latch (m)."""
 SWAP_REWARD = 10.0
+UNBOUNDED_LEAD = 1e9
+"""``turn_lead`` of the turn-shaping aid when its paid turning is not bounded by the swaps (turns)."""
 DENSE_SCALE = 0.1
 DENSE_LENGTH = 0.1
 """Dense reward 0.1 · Σ (1 − tanh(d / 0.1)) per step."""
@@ -132,6 +134,7 @@ class BaodingState:
     # the turn-shaping training aid (roto.tasks.round_swaps.turn_shaping); turn_reward 0 (the benchmark) pays nothing
     net_turn: torch.Tensor  # (B,) float64: the line's signed turns this episode
     turn_reward: torch.Tensor  # () float64: reward per turn the pair's net turning grows by
+    turn_lead: torch.Tensor  # () float64: turns the paid turning may run ahead of half a turn per swap
 
 
 def baoding_rule(
@@ -169,7 +172,9 @@ def follow_turns(state: BaodingState, pos: Array, swap: Array) -> dict[str, Arra
     state.pair_angle, turn = pair_turn_step(pos, state.pair_angle, state.angle_set)
     state.angle_set = state.angle_set | True
     paid, state.turned, state.direction = paid_swaps(swap, state.turned + turn, state.direction, state.min_turn)
-    shaped, state.net_turn = turn_shaping(state.net_turn, turn, state.turn_reward)
+    paid_turns = state.turn_lead + 0.5 * as_dtype_of(state.swaps, pos)  # turns the swaps so far back
+    before = paid_turns - 0.5 * as_dtype_of(swap, pos)  # the bound before this step's swap
+    shaped, state.net_turn = turn_shaping(state.net_turn, turn, state.turn_reward, before, paid_turns)
     return {"swap": paid, "turn": shaped}
 
 
@@ -183,7 +188,9 @@ class Baoding:
     on targets where they rest, partly inside the hand."""
     metric_names = ("swaps", "rotations")
     headline_metric = "rotations"
-    parameters = MappingProxyType({"success_radius": SUCCESS_RADIUS, "swap_min_turn": 0.0, "turn_reward": 0.0})
+    parameters = MappingProxyType(
+        {"success_radius": SUCCESS_RADIUS, "swap_min_turn": 0.0, "turn_reward": 0.0, "turn_lead": UNBOUNDED_LEAD}
+    )
     """What training aids may change: the latch radius (m; a tolerance curriculum starts it wider,
     ``roto.envs.aids.tolerance``), the turns a paid swap must follow (0: every swap is paid; the
     round-swaps aid sets it, ``roto.tasks.round_swaps``) and the reward per turn of the pair's net
@@ -228,11 +235,14 @@ class Baoding:
             min_turn=torch.zeros((), dtype=torch.float64, device=device),
             net_turn=torch.zeros(num_envs, dtype=torch.float64, device=device),
             turn_reward=torch.zeros((), dtype=torch.float64, device=device),
+            turn_lead=torch.tensor(UNBOUNDED_LEAD, dtype=torch.float64, device=device),
         )
 
     def set_parameter(self, state: BaodingState, name: str, value: float | torch.Tensor) -> None:
-        """Set ``success_radius``, ``swap_min_turn`` or ``turn_reward`` of every world (``Task.set_parameter``)."""
+        """Set ``success_radius``, ``swap_min_turn``, ``turn_reward`` or ``turn_lead`` of every world
+        (``Task.set_parameter``)."""
         fields = {"success_radius": "radius", "swap_min_turn": "min_turn", "turn_reward": "turn_reward"}
+        fields["turn_lead"] = "turn_lead"
         set_state_parameter(state, fields, name, value)
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:

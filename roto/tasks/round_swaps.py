@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from roto.tasks.arrays import Array, atan2, where
+from roto.tasks.arrays import Array, atan2, minimum, where
 
 
 def pair_turn_step(ball_pos: Array, pair_angle: Array, angle_set: Array) -> tuple[Array, Array]:
@@ -57,22 +57,27 @@ def paid_swaps(swap: Array, turned: Array, direction: Array, min_turn: float | A
     return paid, where(paid, 0.0, turned), where(paid, way, direction)
 
 
-def turn_shaping(net_turn: Array, turn: Array, turn_reward: float | Array) -> tuple[Array, Array]:
-    """The turn-shaping reward: ``turn_reward`` per turn the magnitude of the pair's net turning
-    this episode grows (pure; torch or numpy).
+def turn_shaping(
+    net_turn: Array, turn: Array, turn_reward: float | Array, cap: Array | float, new_cap: Array | float
+) -> tuple[Array, Array]:
+    """The turn-shaping reward: ``turn_reward`` per turn the pair's paid turning grows (pure; torch
+    or numpy).
 
-    A potential-based shaping term with potential ``turn_reward * |net turns|``: over an episode it
-    sums to ``turn_reward * |net turns at the end|``, so a pair carried round one way earns it for
-    every turn and a swing out and back earns nothing (it pays on the way out what it takes back on
-    the way back). Either way round counts.
+    A potential-based shaping term with potential ``turn_reward * min(|net turns|, cap)``: over an
+    episode it sums to ``turn_reward * min(|net turns|, cap)`` at its end, so a pair carried round
+    one way earns it for every turn and a swing out and back earns nothing (it pays on the way out
+    what it takes back on the way back); either way round counts. ``cap`` bounds the paid turning
+    by the swaps made (Baoding: ``turn_lead`` turns plus half a turn per swap), so spinning the pair
+    faster than the balls trade places stops paying; an unbounded cap pays every turn.
 
     Args:
         net_turn: (B,) signed turns of the ball line so far this episode.
         turn: (B,) signed turns this step (``pair_turn_step``).
         turn_reward: reward per turn (0: the benchmark, nothing paid).
+        cap, new_cap: (B,) the paid turning's bound before and after this step.
 
     Returns:
         (reward (B,), new net_turn (B,))
     """
     net = net_turn + turn
-    return turn_reward * (abs(net) - abs(net_turn)), net
+    return turn_reward * (minimum(abs(net), new_cap) - minimum(abs(net_turn), cap)), net

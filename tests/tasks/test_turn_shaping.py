@@ -20,18 +20,25 @@ from tests.tasks.test_round_swaps import SHADOW, path_round_the_targets
 def test_the_shaping_pays_growth_of_the_net_turning_and_takes_it_back_as_it_shrinks():
     net = torch.tensor([0.0, 0.2, -0.2, 0.1], dtype=torch.float64)
     turn = torch.tensor([0.1, 0.1, -0.1, -0.3], dtype=torch.float64)
-    reward, new_net = turn_shaping(net, turn, 20.0)
+    reward, new_net = turn_shaping(net, turn, 20.0, math.inf, math.inf)
     assert new_net.tolist() == pytest.approx([0.1, 0.3, -0.3, -0.2])
-    assert reward.tolist() == pytest.approx([2.0, 2.0, 2.0, 2.0])  # |0.1| - |-0.2|... each grows by 0.1
-    reward, _ = turn_shaping(torch.tensor([0.3]), torch.tensor([-0.1]), 20.0)
+    assert reward.tolist() == pytest.approx([2.0, 2.0, 2.0, 2.0])  # each magnitude grows by 0.1
+    reward, _ = turn_shaping(torch.tensor([0.3]), torch.tensor([-0.1]), 20.0, math.inf, math.inf)
     assert float(reward[0]) == pytest.approx(-2.0)
+    cap = torch.tensor([0.25, 0.25, 0.25, 0.25], dtype=torch.float64)  # bounded: growth past the cap is unpaid
+    reward, _ = turn_shaping(net, turn, 20.0, cap, cap)
+    assert reward.tolist() == pytest.approx([2.0, 1.0, 1.0, 2.0])
+    reward, _ = turn_shaping(torch.tensor([0.3]), torch.tensor([0.0]), 20.0, 0.25, 0.75)  # a swap lifts the cap
+    assert float(reward[0]) == pytest.approx(1.0)
 
 
-def shaped_rewards(path, turn_reward):
+def shaped_rewards(path, turn_reward, lead=None):
     """(sum of the "turn" term over ``path``, the terms' names) of one Baoding world."""
     task = Baoding()
     state = task.init_state(SHADOW, 1, torch.device("cpu"))
     task.set_parameter(state, "turn_reward", turn_reward)
+    if lead is not None:
+        task.set_parameter(state, "turn_lead", lead)
     total, names = 0.0, set()
     for pos in path:
         inputs = TaskInputs(
@@ -58,6 +65,16 @@ def test_a_pair_carried_round_earns_per_turn_either_way_and_a_swing_earns_nothin
     assert total == 0.0 and names == {"swap", "distance"}
 
 
+def test_bounded_by_the_swaps_a_pair_spun_without_swapping_earns_only_the_lead():
+    round_path = path_round_the_targets(np.linspace(0.5 * math.pi, 4.5 * math.pi, 121))  # two turns, 4 swaps
+    total, _ = shaped_rewards(round_path, 20.0, lead=0.5)
+    assert total == pytest.approx(40.0)  # the swaps keep pace: every turn paid
+    # the same two turns about a point off the targets: the balls never latch, nothing swaps
+    spun = round_path + torch.tensor([0.0, 0.05, 0.0], dtype=torch.float64)
+    assert shaped_rewards(spun, 20.0)[0] == pytest.approx(40.0)  # unbounded: spinning pays
+    assert shaped_rewards(spun, 20.0, lead=0.5)[0] == pytest.approx(10.0)  # bounded: half a turn
+
+
 def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids={"turn_shaping": {"per_turn": 20.0}})
     assert float(env.task_state.turn_reward) == 20.0 and [type(a).__name__ for a in env.aids] == ["TurnShaping"]
@@ -67,6 +84,8 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
         settings.eval_env_config(4).aids.turn_shaping is None and settings.env_config().aids.turn_shaping.per_turn == 20
     )
     assert float(roto.make(**vars(settings.eval_env_config(2))).task_state.turn_reward) == 0.0
+    bounded = roto.make("baoding", num_envs=1, aids={"turn_shaping": {"per_turn": 20.0, "lead": 0.5}})
+    assert float(bounded.task_state.turn_lead) == 0.5 and float(env.task_state.turn_lead) == 1e9
 
 
 @pytest.mark.parametrize(
@@ -76,8 +95,10 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
         ("baoding", -1.0, r"aids.turn_shaping.per_turn must be a reward per turn in \[0, 1000\], got -1.0"),
         ("baoding", float("nan"), r"got nan"),
         ("baoding", "20", r"got '20'"),
+        ("baoding", {"lead": -1.0}, r"aids.turn_shaping.lead must be a number of turns.*got -1.0"),
     ],
 )
 def test_bad_turn_reward_is_refused(task, per_turn, pattern):
     with pytest.raises(ValueError, match=pattern):
-        EnvConfig(task=task, aids={"turn_shaping": {"per_turn": per_turn}})
+        settings = per_turn if isinstance(per_turn, dict) else {"per_turn": per_turn}
+        EnvConfig(task=task, aids={"turn_shaping": settings})

@@ -121,13 +121,19 @@ class TurnShapingSettings:
         per_turn: the reward per turn the magnitude of the pair's net turning this episode grows,
             given back as it shrinks (a full turn makes two swaps: 20 pays as much as their swap
             reward).
+        lead: None: every turn is paid; else the paid turning stops this many turns ahead of half
+            a turn per swap made, so spinning the pair without the balls trading places pays at
+            most ``lead`` turns an episode.
     """
 
     per_turn: float = 20.0
+    lead: float | None = None
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "turn_reward", "a ball pair")
         _number(f"{path}.per_turn", self.per_turn, 0.0, 1000.0, "a reward per turn")
+        if self.lead is not None:
+            _number(f"{path}.lead", self.lead, 0.0, 100.0, "a number of turns (or null: unbounded)")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -10,7 +10,9 @@ from roto.envs.aids.settings import TurnShapingSettings
 
 
 class TurnShaping(TrainingAid):
-    """Sets the task parameter ``turn_reward`` once, when the env is built."""
+    """Sets the task parameters ``turn_reward`` (and ``turn_lead``) once, when the env is built."""
 
     def __init__(self, host: AidHost, settings: TurnShapingSettings) -> None:
         host.task.set_parameter(host.task_state, "turn_reward", settings.per_turn)
+        if settings.lead is not None:  # else the task's own: unbounded
+            host.task.set_parameter(host.task_state, "turn_lead", settings.lead)
