@@ -192,7 +192,7 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
 def cmd_results(args: argparse.Namespace) -> int:
     """Write the tables and curves."""
     from roto.olympiad.plan import load_plan
-    from roto.olympiad.results import write_results
+    from roto.olympiad.results_page import write_results
 
     source = pathlib.Path(args.source)
     if source.is_dir():

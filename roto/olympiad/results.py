@@ -6,7 +6,8 @@ gives the mean ± std over seeds and the interquartile mean with a 95 % stratifi
 interval (``roto.olympiad.stats``), for the final and for the best policy. Hands are rows, task ×
 obs mode × variant are columns, each named with the agent config it trained, with each task's
 reference of each hand (``Task.reference``) and roto v1's Shadow figures (docs/spec.md §9) beside the
-variants that declare themselves roto's agent.
+variants that declare themselves roto's agent. Baoding's pages lead with round rotations
+(``roto.olympiad.path_results``); the page itself is ``roto.olympiad.results_page``.
 """
 
 from __future__ import annotations
@@ -20,11 +21,10 @@ from typing import Any
 import numpy as np
 
 from roto.artifact_formats import FORMAT_KEY, check_format
-from roto.cli_errors import check_output_path
 from roto.eval.plots import plot_variants
 from roto.olympiad.plan import load_plan
 from roto.olympiad.stats import iqm, probability_of_improvement, stratified_bootstrap_ci
-from roto.result_files import read_json, replacing, write_text_atomic
+from roto.result_files import read_json, replacing
 from roto.robots import ROBOTS
 from roto.tasks import get_task
 
@@ -214,46 +214,6 @@ def _format(stats: dict | None) -> str:
     return f"{stats['mean']:.1f} ± {stats['std']:.1f} (IQM {stats['iqm']:.1f} {interval}, n={stats['n']})"
 
 
-def with_derived_means(task: str, evaluation: dict) -> dict:
-    """``evaluation`` (a summary's ``final`` or ``best``) with the ``<name>_mean`` of each of the
-    task's ``derived_metrics`` it lacks but can recompute from its stored episodes (``per_episode``:
-    {measure: one value per episode}); a summary written before such a measure existed gets it so."""
-    episodes = evaluation.get("per_episode") or {}
-    count = min((len(values) for values in episodes.values()), default=0)
-    derived = [get_task(task).derived_metrics({k: v[i] for k, v in episodes.items()}) for i in range(count)]
-    if not derived or not derived[0]:
-        return evaluation
-    means = {f"{name}_mean": float(np.mean([d[name] for d in derived])) for name in derived[0]}
-    return {**means, **evaluation}
-
-
-def path_metric_table(summaries: list[dict]) -> list[str]:
-    """Markdown lines: each seed's ``best.pt`` headline metric beside its path metrics
-    (``Task.path_metrics``, e.g. Baoding's net turns), a table per task that has them; empty if none
-    does. A measure that follows from the stored episodes (``Task.derived_metrics``) is recomputed
-    where a summary lacks it; summaries written before evaluations measured paths say "not measured"."""
-    lines = []
-    for task in sorted({s["task"] for s in summaries}):
-        names = get_task(task).path_metric_names
-        if not names:
-            continue
-        header = ["cell", f"{metric(task)} (best.pt)", *names]
-        lines += [
-            f"## best policy, {task}: path metrics beside the headline metric, per seed",
-            "",
-            "| " + " | ".join(header) + " |",
-            "|" + "---|" * len(header),
-        ]
-        for s in sorted(summaries, key=lambda s: (s["robot"], s["obs"], s["variant"], s["seed"])):
-            if s["task"] == task:
-                best = with_derived_means(task, s["best"])
-                values = [f"{best[f'{n}_mean']:.2f}" if f"{n}_mean" in best else "not measured" for n in names]
-                cell = f"{s['robot']} / {s['obs']} / {s['variant']} / seed {s['seed']}"
-                lines.append("| " + " | ".join([cell, f"{best[f'{metric(task)}_mean']:.2f}", *values]) + " |")
-        lines.append("")
-    return lines
-
-
 def write_csv(scores: dict[Key, np.ndarray], path: pathlib.Path, policy: str) -> None:
     """One row per cell: its statistics and its seeds' scores."""
     with replacing(path) as temporary, temporary.open("w", newline="") as f:
@@ -340,28 +300,3 @@ def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pa
         )
         paths.append(path)
     return paths
-
-
-def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str = "") -> dict[str, str]:
-    """results.md, results.csv and curve PNGs in ``out`` (``--out``: a folder, made with its missing
-    parents; refused, before anything is written, where it cannot be one) from the summaries in ``source``."""
-    summaries = read_summaries(source)
-    out = check_output_path(out, "--out", kind="dir")
-    out.mkdir(parents=True, exist_ok=True)
-    commits = sorted({s["commit"] for s in summaries})
-    label = f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
-    agents = variant_agents(summaries, plan or summaries[0].get("plan", ""))
-    md = [f"# Olympiad results ({label})", ""]
-    for policy in ("final", "best"):
-        scores = scores_by_cell(summaries, policy)
-        write_csv(scores, out / f"results_{policy}.csv", policy)
-        heading = f"## {policy} policy: task metric per 10 s episode, mean ± std over seeds"
-        md += [heading, "", markdown_table(scores, agents, current_tasks(summaries)), ""]
-    md += path_metric_table(summaries)
-    pairs = improvements(scores_by_cell(summaries, "final"))
-    if pairs:
-        md += ["## Probability of improvement (final policies; variants with two or more seeds)", ""]
-        md += [f"- {t} / {r} / {o}: P({x} > {y}) = {p:.2f}" for t, r, o, x, y, p in pairs]
-    write_text_atomic(out / "results.md", "\n".join(md) + "\n")
-    plots = plot_curves(summaries, out, label)
-    return {"markdown": str(out / "results.md"), "plots": [str(p) for p in plots], "cells": len(summaries)}

@@ -1,0 +1,85 @@
+"""Baoding's measures of the balls' paths in ``roto results``: the round rotations its pages lead
+with (``Task.selection_metric``), the path metrics beside the headline metric, and the measures a
+summary written before they existed gets from its stored episodes."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from roto.olympiad.results import Agents, Key, markdown_table, metric
+from roto.tasks import get_task
+
+
+def with_derived_means(task: str, evaluation: dict) -> dict:
+    """``evaluation`` (a summary's ``final`` or ``best``) with the ``<name>_mean`` of each of the
+    task's ``derived_metrics`` it lacks but can recompute from its stored episodes (``per_episode``:
+    {measure: one value per episode}); a summary written before such a measure existed gets it so."""
+    episodes = evaluation.get("per_episode") or {}
+    count = min((len(values) for values in episodes.values()), default=0)
+    derived = [get_task(task).derived_metrics({k: v[i] for k, v in episodes.items()}) for i in range(count)]
+    if not derived or not derived[0]:
+        return evaluation
+    means = {f"{name}_mean": float(np.mean([d[name] for d in derived])) for name in derived[0]}
+    return {**means, **evaluation}
+
+
+def path_metric_table(summaries: list[dict]) -> list[str]:
+    """Markdown lines: each seed's ``best.pt`` headline metric beside its path metrics
+    (``Task.path_metrics``, e.g. Baoding's net turns), a table per task that has them; empty if none
+    does. A measure that follows from the stored episodes (``Task.derived_metrics``) is recomputed
+    where a summary lacks it; summaries written before evaluations measured paths say "not measured"."""
+    lines = []
+    for task in sorted({s["task"] for s in summaries}):
+        names = get_task(task).path_metric_names
+        if not names:
+            continue
+        header = ["cell", f"{metric(task)} (best.pt)", *names]
+        lines += [
+            f"## best policy, {task}: path metrics beside the headline metric, per seed",
+            "",
+            "| " + " | ".join(header) + " |",
+            "|" + "---|" * len(header),
+        ]
+        for s in sorted(summaries, key=lambda s: (s["robot"], s["obs"], s["variant"], s["seed"])):
+            if s["task"] == task:
+                best = with_derived_means(task, s["best"])
+                values = [f"{best[f'{n}_mean']:.2f}" if f"{n}_mean" in best else "not measured" for n in names]
+                cell = f"{s['robot']} / {s['obs']} / {s['variant']} / seed {s['seed']}"
+                lines.append("| " + " | ".join([cell, f"{best[f'{metric(task)}_mean']:.2f}", *values]) + " |")
+        lines.append("")
+    return lines
+
+
+def lead_scores(summaries: Iterable[dict], policy: str = "best") -> tuple[dict[Key, np.ndarray], list[Key]]:
+    """The cells of tasks that lead with another measure than their headline metric
+    (``Task.selection_metric``: Baoding's round rotations): ({cell: (seeds,) scores of that measure},
+    [cells whose summaries, some seed's at least, did not measure it, nor can it be recomputed])."""
+    found: dict[Key, list[tuple[int, float | None]]] = {}
+    for s in summaries:
+        lead = get_task(s["task"]).selection_metric
+        if lead is None:
+            continue
+        value = with_derived_means(s["task"], s[policy]).get(f"{lead}_mean")
+        found.setdefault((s["task"], s["robot"], s["obs"], s["variant"]), []).append((s["seed"], value))
+    measured = {key: runs for key, runs in found.items() if all(v is not None for _, v in runs)}
+    scores = {key: np.array([v for _, v in sorted(runs)]) for key, runs in sorted(measured.items())}
+    return scores, sorted(set(found) - set(measured))
+
+
+def lead_section(summaries: list[dict], agents: Agents) -> list[str]:
+    """Markdown lines leading the results where a task leads with another measure than its headline
+    metric: the best policies' round rotations (Baoding), before roto's swap count; empty if none."""
+    scores, unmeasured = lead_scores(summaries, "best")
+    if not scores and not unmeasured:
+        return []
+    tasks = sorted({key[0] for key in (*scores, *unmeasured)})
+    names = ", ".join(f"{t}: {get_task(t).selection_metric} (roto's {metric(t)} in the tables below)" for t in tasks)
+    lines = [f"## best policy: {names}, per 10 s episode, mean ± std over seeds", ""]
+    if scores:
+        lines += [markdown_table(scores, agents), ""]
+    if unmeasured:
+        cells = ", ".join(" / ".join(key) for key in unmeasured)
+        lines += [f"Not measured (summaries written before evaluations followed the balls' paths): {cells}.", ""]
+    return lines

@@ -1,0 +1,46 @@
+"""``roto results``' page: results.md (the lead measures, each policy's table, the path metrics,
+the probabilities of improvement), the CSVs and the curves, from a folder of cell summaries."""
+
+from __future__ import annotations
+
+import pathlib
+
+from roto.cli_errors import check_output_path
+from roto.olympiad.path_results import lead_section, path_metric_table
+from roto.olympiad.results import (
+    current_tasks,
+    improvements,
+    markdown_table,
+    plot_curves,
+    read_summaries,
+    scores_by_cell,
+    variant_agents,
+    write_csv,
+)
+from roto.result_files import write_text_atomic
+
+
+def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str = "") -> dict[str, str]:
+    """results.md, results.csv and curve PNGs in ``out`` (``--out``: a folder, made with its missing
+    parents; refused, before anything is written, where it cannot be one) from the summaries in ``source``."""
+    summaries = read_summaries(source)
+    out = check_output_path(out, "--out", kind="dir")
+    out.mkdir(parents=True, exist_ok=True)
+    commits = sorted({s["commit"] for s in summaries})
+    label = f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
+    agents = variant_agents(summaries, plan or summaries[0].get("plan", ""))
+    md = [f"# Olympiad results ({label})", "", *lead_section(summaries, agents)]
+    for policy in ("final", "best"):
+        scores = scores_by_cell(summaries, policy)
+        write_csv(scores, out / f"results_{policy}.csv", policy)
+        heading = f"## {policy} policy: the task's headline metric (Baoding: roto's count) per 10 s episode"
+        heading += ", mean ± std over seeds"
+        md += [heading, "", markdown_table(scores, agents, current_tasks(summaries)), ""]
+    md += path_metric_table(summaries)
+    pairs = improvements(scores_by_cell(summaries, "final"))
+    if pairs:
+        md += ["## Probability of improvement (final policies; variants with two or more seeds)", ""]
+        md += [f"- {t} / {r} / {o}: P({x} > {y}) = {p:.2f}" for t, r, o, x, y, p in pairs]
+    write_text_atomic(out / "results.md", "\n".join(md) + "\n")
+    plots = plot_curves(summaries, out, label)
+    return {"markdown": str(out / "results.md"), "plots": [str(p) for p in plots], "cells": len(summaries)}
