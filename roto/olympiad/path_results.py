@@ -68,9 +68,10 @@ def lead_scores(summaries: Iterable[dict], policy: str = "best") -> tuple[dict[K
     return scores, sorted(set(found) - set(measured))
 
 
-def lead_section(summaries: list[dict], agents: Agents) -> list[str]:
+def lead_section(summaries: list[dict], agents: Agents, current: set[str]) -> list[str]:
     """Markdown lines leading the results where a task leads with another measure than its headline
-    metric: the best policies' round rotations (Baoding), before roto's swap count; empty if none."""
+    metric: the best policies' round rotations (Baoding), before roto's swap count; empty if none.
+    ``current``: the tasks whose summaries are all of the task's current version."""
     scores, unmeasured = lead_scores(summaries, "best")
     if not scores and not unmeasured:
         return []
@@ -78,7 +79,7 @@ def lead_section(summaries: list[dict], agents: Agents) -> list[str]:
     names = ", ".join(f"{t}: {get_task(t).selection_metric} (roto's {metric(t)} in the tables below)" for t in tasks)
     lines = [f"## best policy: {names}, per 10 s episode, mean ± std over seeds", ""]
     if scores:
-        lines += [markdown_table(scores, agents), ""]
+        lines += [markdown_table(scores, agents, current, references=False), ""]
     if unmeasured:
         cells = ", ".join(" / ".join(key) for key in unmeasured)
         lines += [f"Not measured (summaries written before evaluations followed the balls' paths): {cells}.", ""]

@@ -167,9 +167,15 @@ def current_tasks(summaries: list[dict]) -> set[str]:
     return {t for t in tasks if all(s.get("task_version") == get_task(t).version for s in summaries if s["task"] == t)}
 
 
-def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None, current: set[str] | None = None) -> str:
+def markdown_table(
+    scores: dict[Key, np.ndarray],
+    agents: Agents | None = None,
+    current: set[str] | None = None,
+    references: bool = True,
+) -> str:
     """Hands as rows, (task, obs, variant: its agent) as columns; each task's reference (``Task.reference``)
-    and roto v1's figure beside the variants that declare themselves roto's agent."""
+    and roto v1's figure beside the variants that declare themselves roto's agent (``references``:
+    both are in the headline metric, so a table of another measure leaves them out)."""
     agents = agents or {}
     columns = sorted({(task, obs, variant) for task, _, obs, variant in scores})
     tasks = sorted({task for task, _, _ in columns})
@@ -184,8 +190,8 @@ def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None, 
         return f"{task} ({version}) / {obs} / {variant}" + (f": {label}" if label else "")
 
     head = ["hand", *(header(*column) for column in columns)]
-    head += [f"{get_task(t).reference_name} ({metric(t)}, v{get_task(t).version})" for t in current]
-    tasks = current  # a reference stands only beside scores of the task it was measured on
+    tasks = current if references else []  # a reference stands only beside scores of the task it was measured on
+    head += [f"{get_task(t).reference_name} ({metric(t)}, v{get_task(t).version})" for t in tasks]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for robot in robots:
         cells = [
@@ -199,7 +205,7 @@ def markdown_table(scores: dict[Key, np.ndarray], agents: Agents | None = None, 
         roto_agent = agents.get((task, variant), {}).get("roto_agent")
         figure = ROTO_V1_SHADOW.get((task, obs, roto_agent)) if roto_agent else None
         reference.append(f"{figure} ({roto_agent})" if figure is not None else "")
-    if any(reference):  # no row of blanks where no column is roto's agent
+    if references and any(reference):  # no row of blanks where no column is roto's agent
         row = ["roto v1, Shadow, 200 M steps (5 seeds)", *reference, *[""] * len(tasks)]
         lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines)

@@ -29,7 +29,7 @@ def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str
     commits = sorted({s["commit"] for s in summaries})
     label = f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
     agents = variant_agents(summaries, plan or summaries[0].get("plan", ""))
-    md = [f"# Olympiad results ({label})", "", *lead_section(summaries, agents)]
+    md = [f"# Olympiad results ({label})", "", *lead_section(summaries, agents, current_tasks(summaries))]
     for policy in ("final", "best"):
         scores = scores_by_cell(summaries, policy)
         write_csv(scores, out / f"results_{policy}.csv", policy)
