@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # A blind Bounce sweep per hand other than the Shadow (whose sweep made bounce_cpu_quickstart), each
 # started from the Shadow's configuration (enqueued as its first trial), at the CPU Olympiad's
-# budget of 5 M env steps, then exported as the hand's packaged config roto/configs/bounce_cpu_<hand>.yaml
-# (a diff from bounce_cpu_quickstart), unless that file has since been rewritten by hand. Two
+# budget of 5 M env steps, then exported as a candidate config, benchmarks/results/sweeps/<study>.yaml
+# (a diff from bounce_cpu_quickstart). A candidate becomes the hand's recipe (roto/configs/, named in
+# the hand's record, PairRecord.recipe) only after the Olympiad's seeds confirm it (docs/sweeps.md). Two
 # one-thread workers; about 16 trials x 40 minutes / 2 per hand, fewer when pruned. Each study's
 # journal lives in benchmarks/results/sweeps/<study>.journal.log (commit it after a sitting), so
 # rerunning continues where it stopped, on this machine or on a new clone: finished trials stay
@@ -24,11 +25,5 @@ for robot in "${hands[@]}"; do
         --enqueue_base --num_envs 128 --threads 1 --torch_threads 1 --workers "${WORKERS:-2}" --reclaim-now \
         --storage "$journal"
     roto sweep show --study "$study" --storage "$journal" > "benchmarks/results/sweeps/$study.md"
-    config="roto/configs/bounce_cpu_$robot.yaml"
-    # a config written after its export was checked on more seeds (bounce_cpu_allegro) is not overwritten
-    if [[ ! -f $config ]] || head -1 "$config" | grep -q '^# roto sweep export:'; then
-        roto sweep export --study "$study" --storage "$journal" --out "$config"
-    else
-        echo "$config is not a sweep's export (checked on more seeds, docs/sweeps.md): left as it is" >&2
-    fi
+    roto sweep export --study "$study" --storage "$journal" --out "benchmarks/results/sweeps/$study.yaml"
 done
