@@ -20,27 +20,39 @@ from roto.olympiad.results import (
 from roto.result_files import write_text_atomic
 
 
+def page_label(summaries: list[dict], plan: str = "") -> str:
+    """ "plan <name>, commit <c1>, <c2>" of a folder of summaries (``plan``: a name or file that wins
+    over the plan the summaries record)."""
+    commits = sorted({s["commit"] for s in summaries})
+    return f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
+
+
+def results_markdown(summaries: list[dict], plan: str = "") -> str:
+    """results.md of ``summaries``: the lead measures, each policy's table, the path metrics and the
+    probabilities of improvement (what ``write_results`` writes, without the CSVs and curves)."""
+    agents = variant_agents(summaries, plan or summaries[0].get("plan", ""))
+    current = current_tasks(summaries)
+    md = [f"# Olympiad results ({page_label(summaries, plan)})", "", *lead_section(summaries, agents, current)]
+    for policy in ("final", "best"):
+        heading = f"## {policy} policy: the task's headline metric (Baoding: roto's count) per 10 s episode"
+        heading += ", mean ± std over seeds"
+        md += [heading, "", markdown_table(scores_by_cell(summaries, policy), agents, current), ""]
+    md += path_metric_table(summaries)
+    pairs = improvements(scores_by_cell(summaries, "final"))
+    if pairs:
+        md += ["## Probability of improvement (final policies; variants with two or more seeds)", ""]
+        md += [f"- {t} / {r} / {o}: P({x} > {y}) = {p:.2f}" for t, r, o, x, y, p in pairs]
+    return "\n".join(md) + "\n"
+
+
 def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str = "") -> dict[str, str]:
     """results.md, results.csv and curve PNGs in ``out`` (``--out``: a folder, made with its missing
     parents; refused, before anything is written, where it cannot be one) from the summaries in ``source``."""
     summaries = read_summaries(source)
     out = check_output_path(out, "--out", kind="dir")
     out.mkdir(parents=True, exist_ok=True)
-    commits = sorted({s["commit"] for s in summaries})
-    label = f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
-    agents = variant_agents(summaries, plan or summaries[0].get("plan", ""))
-    md = [f"# Olympiad results ({label})", "", *lead_section(summaries, agents, current_tasks(summaries))]
     for policy in ("final", "best"):
-        scores = scores_by_cell(summaries, policy)
-        write_csv(scores, out / f"results_{policy}.csv", policy)
-        heading = f"## {policy} policy: the task's headline metric (Baoding: roto's count) per 10 s episode"
-        heading += ", mean ± std over seeds"
-        md += [heading, "", markdown_table(scores, agents, current_tasks(summaries)), ""]
-    md += path_metric_table(summaries)
-    pairs = improvements(scores_by_cell(summaries, "final"))
-    if pairs:
-        md += ["## Probability of improvement (final policies; variants with two or more seeds)", ""]
-        md += [f"- {t} / {r} / {o}: P({x} > {y}) = {p:.2f}" for t, r, o, x, y, p in pairs]
-    write_text_atomic(out / "results.md", "\n".join(md) + "\n")
-    plots = plot_curves(summaries, out, label)
+        write_csv(scores_by_cell(summaries, policy), out / f"results_{policy}.csv", policy)
+    write_text_atomic(out / "results.md", results_markdown(summaries, plan))
+    plots = plot_curves(summaries, out, page_label(summaries, plan))
     return {"markdown": str(out / "results.md"), "plots": [str(p) for p in plots], "cells": len(summaries)}
