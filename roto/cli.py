@@ -111,7 +111,10 @@ def _cmd_train(args: argparse.Namespace) -> int:
         return 130
     plot_learning_curve(trainer.run_dir)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
-    summary.update({k.removeprefix("eval/"): v for k, v in last.items()})
+    lead = f"eval/{trainer.env.task.selection_metric}_"  # Baoding: its round rotations first
+    summary.update(
+        {k.removeprefix("eval/"): v for k, v in sorted(last.items(), key=lambda kv: not kv[0].startswith(lead))}
+    )
     summary["spec"] = trainer.spec.to_dict()
     print(json.dumps(summary))
     return 0
