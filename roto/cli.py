@@ -111,10 +111,12 @@ def _cmd_train(args: argparse.Namespace) -> int:
         return 130
     plot_learning_curve(trainer.run_dir)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
-    lead = f"eval/{trainer.env.task.selection_metric}_"  # Baoding: its round rotations first
-    summary.update(
-        {k.removeprefix("eval/"): v for k, v in sorted(last.items(), key=lambda kv: not kv[0].startswith(lead))}
-    )
+    lead = trainer.env.task.selection_metric  # Baoding: its round rotations first
+
+    def later(key: str) -> bool:
+        return lead is None or not key.startswith(f"eval/{lead}_")
+
+    summary.update({k.removeprefix("eval/"): v for k, v in sorted(last.items(), key=lambda kv: later(kv[0]))})
     summary["spec"] = trainer.spec.to_dict()
     print(json.dumps(summary))
     return 0

@@ -44,8 +44,9 @@ def best_eval_key(record: dict[str, Any], selection_metric: str | None) -> tuple
 
 
 def load_best_eval(state: dict[str, Any], selection_metric: str | None) -> tuple[float, float]:
-    """``best_eval_key`` of a checkpoint's best evaluation; for a checkpoint that kept only the best
-    return, that return (the metric unknown: -inf, so the next evaluation takes ``best.pt`` over)."""
+    """``best_eval_key`` of a checkpoint's best evaluation; for a checkpoint of format 1 or 2, which
+    kept only the best return (``best_eval_return``), that return (the metric unknown: -inf, so the
+    next evaluation takes ``best.pt`` over)."""
     if "best_eval" in state:
         metric, ret = state["best_eval"]
         return float(metric), float(ret)

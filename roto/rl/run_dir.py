@@ -24,7 +24,7 @@ from roto.rl.run_spec import RunSpec
 
 CHECKPOINT_DIR = "checkpoints"
 POLICY_KEYS = ("format", "model", "spec", "obs_sizes", "num_actions", "update", "env_steps")
-POLICY_KEYS += ("best_eval_return", "best_eval", "last_eval")
+POLICY_KEYS += ("best_eval", "last_eval")
 """What a policy-only checkpoint holds: enough for ``load_policy``, ``roto eval`` and ``roto play``."""
 
 

@@ -269,7 +269,6 @@ class Trainer:
             "num_actions": self.env.num_actions,
             "update": self.update,
             "env_steps": self.env_steps,
-            "best_eval_return": self.best_eval[1],
             "best_eval": list(self.best_eval),
             "last_eval": self.last_eval,
         }

@@ -30,6 +30,10 @@ BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
 """A ball within this distance of its current target sets its latch (m)."""
 SWAP_REWARD = 10.0
+PARAMETER_FIELDS = MappingProxyType(
+    {"success_radius": "radius", "swap_min_turn": "min_turn", "turn_reward": "turn_reward", "turn_lead": "turn_lead"}
+)
+"""{task parameter: the ``BaodingState`` field that holds it}."""
 UNBOUNDED_LEAD = 1e9
 """``turn_lead`` of the turn-shaping aid when its paid turning is not bounded by the swaps (turns)."""
 DENSE_SCALE = 0.1
@@ -241,9 +245,7 @@ class Baoding:
     def set_parameter(self, state: BaodingState, name: str, value: float | torch.Tensor) -> None:
         """Set ``success_radius``, ``swap_min_turn``, ``turn_reward`` or ``turn_lead`` of every world
         (``Task.set_parameter``)."""
-        fields = {"success_radius": "radius", "swap_min_turn": "min_turn", "turn_reward": "turn_reward"}
-        fields["turn_lead"] = "turn_lead"
-        set_state_parameter(state, fields, name, value)
+        set_state_parameter(state, PARAMETER_FIELDS, name, value)
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:
         """Clear the latches, swap count and assignment (ball a -> T_a, ball b -> T_b), and the ball
