@@ -59,6 +59,16 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def lead_first(evaluation: dict[str, float], lead: str | None) -> dict[str, float]:
+    """An evaluation's ``eval/<name>`` scalars without the prefix, those of the task's ``lead``
+    measure (Baoding: round rotations) first."""
+
+    def later(item: tuple[str, float]) -> bool:
+        return lead is None or not item[0].startswith(f"eval/{lead}_")
+
+    return {key.removeprefix("eval/"): value for key, value in sorted(evaluation.items(), key=later)}
+
+
 def _cmd_train(args: argparse.Namespace) -> int:
     import pathlib
     import time
@@ -111,12 +121,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         return 130
     plot_learning_curve(trainer.run_dir)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
-    lead = trainer.env.task.selection_metric  # Baoding: its round rotations first
-
-    def later(key: str) -> bool:
-        return lead is None or not key.startswith(f"eval/{lead}_")
-
-    summary.update({k.removeprefix("eval/"): v for k, v in sorted(last.items(), key=lambda kv: later(kv[0]))})
+    summary.update(lead_first(last, trainer.env.task.selection_metric))
     summary["spec"] = trainer.spec.to_dict()
     print(json.dumps(summary))
     return 0
