@@ -1,5 +1,5 @@
 """Format versions of the files roto writes and reads back: checkpoints, run configs, cell
-summaries and banks of recorded states each carry ``format``; a reader refuses a format it does
+summaries, banks of recorded states and submissions each carry ``format``; a reader refuses a format it does
 not know in one line, instead of misreading a file a newer roto wrote. A file without the entry
 predates format versions and has format 1's layout.
 """
@@ -9,7 +9,7 @@ from __future__ import annotations
 from types import MappingProxyType
 
 FORMAT_KEY = "format"
-FORMATS = MappingProxyType({"checkpoint": 3, "run config": 3, "cell summary": 1, "bank": 1})
+FORMATS = MappingProxyType({"checkpoint": 3, "run config": 3, "cell summary": 1, "bank": 1, "submission": 1})
 """{kind of file: the format this roto writes (and the newest it reads)}. Checkpoints and run
 configs: 2, the env's training aids in one ``aids`` section (format 1 held them as flat env fields;
 ``roto.envs.aids.settings.aids_from_legacy_fields`` reads them); 3, the run's ``RunSpec`` (env,

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from roto.cli_args import add_env_args, add_touch_arg, options_given
 from roto.cli_demo import add_demo_parser
 from roto.cli_errors import check_output_path, error_exit, make_parents, quiet_on_closed_stdout
+from roto.eval.protocol import EVAL_EPISODES, EVAL_SEED
 from roto.olympiad.command import add_olympiad_parsers
 from roto.rl.config_help import HelpConfigAction
 from roto.rl.stop_requests import interrupt_on_sigterm
@@ -159,12 +160,18 @@ def _cmd_eval(args: argparse.Namespace) -> int:
     from roto.eval.evaluate import evaluate
     from roto.result_files import write_text_atomic
     from roto.rl.run_dir import load_policy
+    from roto.tasks import get_task
 
     out = pathlib.Path(args.out) if args.out else pathlib.Path(args.checkpoint).with_suffix(".eval.json")
     check_output_path(out, "--out", example="eval.json")  # before the evaluation, which would be lost
     model, spec = load_policy(args.checkpoint)
     result = evaluate(model, spec, episodes=args.episodes, seed=args.seed)
-    result = {"checkpoint": str(args.checkpoint), "task": spec.env.task, "robot": spec.env.robot, **result}
+    env = spec.env
+    result = {
+        "checkpoint": str(args.checkpoint),
+        **{"task": env.task, "task_version": get_task(env.task).version, "robot": env.robot, "obs": env.obs_mode},
+        **{"touch": env.touch, "train_seed": env.seed, **result},
+    }
     write_text_atomic(make_parents(out), json.dumps(result, indent=1))
     print(json.dumps({k: v for k, v in result.items() if k != "per_episode"}))
     print(f"wrote {out}", file=sys.stderr)
@@ -250,8 +257,8 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
 def _add_eval_parser(sub: argparse._SubParsersAction) -> None:
     p_eval = sub.add_parser("eval", help="evaluate a checkpoint over full episodes (deterministic policy)")
     p_eval.add_argument("--checkpoint", required=True)
-    p_eval.add_argument("--episodes", type=int, default=100)
-    p_eval.add_argument("--seed", type=int, default=1_000_000)
+    p_eval.add_argument("--episodes", type=int, default=EVAL_EPISODES)
+    p_eval.add_argument("--seed", type=int, default=EVAL_SEED)
     p_eval.add_argument(
         "--out", default=None, help="JSON path (default: next to the checkpoint; missing folders are created)"
     )

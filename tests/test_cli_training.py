@@ -81,6 +81,9 @@ def test_eval_prints_and_writes_json(trained_run, tmp_path, capsys):
     written = json.loads(out.read_text())
     assert printed["episodes"] == 3 and len(written["per_episode"]["bounces"]) == 3
     assert {"return_mean", "return_std", "bounces_mean", "length_mean"} <= printed.keys()
+    cell = {"task": "bounce", "task_version": 0, "robot": "shadow", "obs": "blind", "touch": "binary"}
+    assert {key: written[key] for key in cell} == cell and written["seed"] == 1_000_000
+    assert written["train_seed"] == yaml.safe_load((trained_run / "config.yaml").read_text())["env"]["seed"]
 
 
 def test_eval_reads_a_gpu_trained_policy_only_checkpoint_as_gpu_suite_writes_it(trained_run, tmp_path, capsys):

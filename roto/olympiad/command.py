@@ -9,6 +9,7 @@ import pathlib
 from typing import TYPE_CHECKING
 
 from roto.jobs.flags import add_worker_flags
+from roto.olympiad.submission_command import add_results_submission_flags, add_submit_parser, cmd_check
 from roto.sweep.command import STORAGE_HELP
 
 if TYPE_CHECKING:
@@ -39,10 +40,14 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     )
     p.set_defaults(func=cmd_olympiad)
     r = sub.add_parser("results", help="tables (markdown, CSV) and learning curves of an Olympiad's cells")
-    r.add_argument("source", help="a plan's name or file (its default results folder), or a folder of summaries")
-    r.add_argument("--out", required=True, help="folder to write results.md, results_*.csv and curves_*.png into")
+    r.add_argument(
+        "source", nargs="?", help="a plan's name or file (its default results folder), or a folder of summaries"
+    )
+    r.add_argument("--out", default=None, help="folder to write results.md, results_*.csv and curves_*.png into")
     r.add_argument("--root", default="runs/olympiad")
+    add_results_submission_flags(r)
     r.set_defaults(func=cmd_results)
+    add_submit_parser(sub)
 
 
 def _results_dir(args: argparse.Namespace, plan_name: str) -> pathlib.Path:
@@ -190,15 +195,21 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
 
 
 def cmd_results(args: argparse.Namespace) -> int:
-    """Write the tables and curves."""
+    """Write the tables and curves (with ``--check FILE``: check one submission, write nothing)."""
     from roto.olympiad.plan import load_plan
     from roto.olympiad.results_page import write_results
 
+    if args.check is not None:
+        if args.source or args.out or args.submissions:
+            raise ValueError("roto results --check FILE checks one submission and writes nothing; give it alone")
+        return cmd_check(args.check)
+    if args.source is None or args.out is None:
+        raise ValueError("roto results needs SOURCE (a plan or a folder of summaries) and --out FOLDER")
     source = pathlib.Path(args.source)
     if source.is_dir():
         folder, name = source, ""
     else:
         name = load_plan(args.source).name
         folder = pathlib.Path(args.root) / name / "results"
-    print(json.dumps(write_results(folder, args.out, plan=name)))
+    print(json.dumps(write_results(folder, args.out, plan=name, submissions=args.submissions)))
     return 0

@@ -17,6 +17,7 @@ from roto.olympiad.results import (
     variant_agents,
     write_csv,
 )
+from roto.olympiad.submission_command import with_submissions
 from roto.result_files import write_text_atomic
 
 
@@ -45,10 +46,15 @@ def results_markdown(summaries: list[dict], plan: str = "") -> str:
     return "\n".join(md) + "\n"
 
 
-def write_results(source: str | pathlib.Path, out: str | pathlib.Path, plan: str = "") -> dict[str, str]:
+def write_results(
+    source: str | pathlib.Path, out: str | pathlib.Path, plan: str = "", submissions: str | None = None
+) -> dict[str, str]:
     """results.md, results.csv and curve PNGs in ``out`` (``--out``: a folder, made with its missing
-    parents; refused, before anything is written, where it cannot be one) from the summaries in ``source``."""
+    parents; refused, before anything is written, where it cannot be one) from the summaries in
+    ``source`` and, beside them, the submissions in the folder ``submissions``."""
     summaries = read_summaries(source)
+    if submissions is not None:
+        summaries = with_submissions(summaries, submissions)
     out = check_output_path(out, "--out", kind="dir")
     out.mkdir(parents=True, exist_ok=True)
     for policy in ("final", "best"):
