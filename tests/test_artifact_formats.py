@@ -20,7 +20,7 @@ from roto.rl.run_spec import RunSpec
 from tests.conftest import SHADOW_BANK
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-SUMMARY = ROOT / "benchmarks" / "results" / "olympiad_cpu" / "bounce-shadow-blind-ppo-seed0.json"
+SUMMARY = ROOT / "benchmarks" / "results" / "benchmark" / "cells" / "bounce-shadow-blind-ppo-seed0.json"
 
 
 def newer_checkpoint(path):

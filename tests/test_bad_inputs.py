@@ -80,7 +80,7 @@ CASES = {
         2,
         "nosuch",
     ),
-    "zero workers": (lambda d: ["olympiad", "cpu", "--root", str(d / "o"), "--workers", "0"], 2, "--workers"),
+    "zero workers": (lambda d: ["olympiad", "benchmark", "--root", str(d / "o"), "--workers", "0"], 2, "--workers"),
     "pre-swap states at a directory": (
         lambda d: ["demo", "--task", "baoding", "--preswap_out", str(d)],
         2,

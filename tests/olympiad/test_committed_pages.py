@@ -1,6 +1,7 @@
 """Every committed results page is what its summaries generate now: a page left behind when its
-summaries, a plan's labels or the page's layout change fails here (regenerate it with
-``roto results <folder> --out <folder>_tables``)."""
+summaries, a plan's labels or the page's layout change fails here. A page in ``.../tables/...``
+is made from the summaries at the same place under ``results`` (the benchmark's: ``cells``):
+regenerate it with ``roto results <summaries> --out <tables>``."""
 
 import pathlib
 
@@ -9,15 +10,37 @@ import pytest
 from roto.olympiad.results import read_summaries
 from roto.olympiad.results_page import results_markdown
 
-RESULTS = pathlib.Path(__file__).resolve().parents[2] / "benchmarks" / "results"
-PAGES = sorted(p for p in RESULTS.glob("*_tables/results.md") if (RESULTS / p.parent.name[: -len("_tables")]).is_dir())
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
-@pytest.mark.parametrize("page", PAGES, ids=[p.parent.name for p in PAGES])
+def summaries_of(page: pathlib.Path) -> pathlib.Path | None:
+    """The folder of summaries a committed page is made from, None if it has none."""
+    parts = page.parent.relative_to(ROOT).parts
+    if "tables" not in parts:
+        return None
+    i = len(parts) - 1 - parts[::-1].index("tables")
+    for name in ("results", "cells"):
+        folder = ROOT.joinpath(*parts[:i], name, *parts[i + 1 :])
+        if folder.is_dir():
+            return folder
+    return None
+
+
+PAGES = sorted(
+    page
+    for top in ("benchmarks/results", "experiments")
+    for page in (ROOT / top).rglob("results.md")
+    if summaries_of(page) is not None
+)
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[str(p.parent.relative_to(ROOT)) for p in PAGES])
 def test_a_committed_page_is_what_its_summaries_generate(page):
-    summaries = read_summaries(RESULTS / page.parent.name[: -len("_tables")])
+    summaries = read_summaries(summaries_of(page))
     assert page.read_text() == results_markdown(summaries), f"regenerate {page.parent}"
 
 
 def test_the_pages_are_found():
+    found = {str(page.parent.relative_to(ROOT)) for page in PAGES}
+    assert {"benchmarks/results/benchmark/tables", "experiments/baoding_v1/tables/baoding_v1_cpu"} <= found
     assert len(PAGES) >= 10

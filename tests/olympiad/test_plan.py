@@ -11,26 +11,26 @@ from roto.robots import ROBOTS
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
+EXPERIMENT_PLANS = {path.stem: path for path in (ROOT / "experiments").glob("*/*.yaml")}
+"""The plans roto's experiments ran (experiments/<study>/<plan>.yaml), by name."""
+
+
+def plan_named(name: str):
+    """A packaged plan, or an experiment's by its file's name."""
+    return load_plan(str(EXPERIMENT_PLANS[name]) if name in EXPERIMENT_PLANS else name)
+
+
+@pytest.mark.parametrize("name", sorted(EXPERIMENT_PLANS))
+def test_every_experiments_plan_still_passes_the_plan_check(name):
+    """An experiment's command still runs: its configs, banks and overrides load with today's roto."""
+    assert plan_named(name).cells
+
+
 def test_packaged_plans():
-    assert set(packaged_plans()) == {
-        "benchmark",
-        "cpu",
-        "paper",
-        "variants_bounce",
-        "variants_baoding",
-        "baoding_v1_cpu",
-        "baoding_v1_ablations",
-        "baoding_v1_more_aids",
-        "baoding_v1_shadow_more_aids",
-        "bounce_long_shadow",
-        "bounce_shadow_probes",
-        "bounce_allegro_probe",
-        "baoding_v1_low_noise",
-        "baoding_v1_round",
-        "baoding_v1_orca_round",
-        "baoding_v1_shadow_round",
-    }
-    cpu = load_plan("cpu")
+    assert set(packaged_plans()) == {"benchmark", "paper", "smoke"}
+    smoke = load_plan("smoke")
+    assert [c.name for c in smoke.cells] == ["bounce-shadow-blind-ppo-seed0", "baoding-shadow-blind-ppo-seed0"]
+    cpu = plan_named("cpu")
     names = [c.name for c in cpu.cells]
     assert len(names) == 28 and cpu.steps == 5_000_000 and cpu.eval_episodes == 100
     assert sum(n.startswith("bounce-") and "-blind-" in n for n in names) == 8  # 4 hands x 2 seeds
@@ -47,7 +47,7 @@ def test_packaged_plans():
     assert recipes == {**quickstart, "orca": "bounce_cpu_orca"}
     shadow, orca = (load_agent_config("bounce", recipes[r]) for r in ("shadow", "orca"))
     assert orca.ppo.lr != shadow.ppo.lr
-    long = load_plan("bounce_long_shadow")
+    long = plan_named("bounce_long_shadow")
     assert [c.name for c in long.cells] == [f"bounce-shadow-blind-quickstart-seed{s}" for s in (0, 1)]
     assert long.steps == 20_000_000 and long.variants["quickstart"].agent_for("bounce") == ("bounce_cpu_quickstart", [])
     paper = load_plan("paper")
@@ -102,43 +102,44 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
 
     results = tmp_path / "results"
     results.mkdir()
-    committed = ROOT / "benchmarks" / "results" / "olympiad_cpu" / "bounce-shadow-blind-ppo-seed0.json"
+    committed = ROOT / "benchmarks" / "results" / "benchmark" / "cells" / "bounce-shadow-blind-ppo-seed0.json"
     done = {**json.loads(committed.read_text()), "env_steps": 5_000_000, "train_wall_s": 1000.0}  # 5000 env steps/s
     (results / "bounce-shadow-blind-ppo-seed0.json").write_text(json.dumps(done))
-    assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
+    assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
     out = capsys.readouterr().out
     assert "bounce-shadow-blind-ppo-seed0" in out and out.count(" done\n") == 1
-    # 27 cells left x 5 M steps at 5000 env steps/s = 27000 s
-    assert "1 done, 27 left; time left: 7.5 h for one worker at 5000 env steps/s" in out
-    assert not (tmp_path / "cpu").exists()  # a dry run creates no study
-    started = tmp_path / "cpu" / "bounce-allegro-blind-ppo-seed0"  # a cell's run, 2.5 M steps in
+    # 35 cells left x 5 M steps at 5000 env steps/s = 35000 s
+    assert "1 done, 35 left; time left: 9.7 h for one worker at 5000 env steps/s" in out
+    assert not (tmp_path / "benchmark").exists()  # a dry run creates no study
+    started = tmp_path / "benchmark" / "bounce-allegro-blind-ppo-seed0"  # a cell's run, 2.5 M steps in
     started.mkdir(parents=True)
     rounds = [{"update": 305, "env_steps": 1_250_000, "bounces_mean": 31.5},
               {"update": 610, "env_steps": 2_500_000, "bounces_mean": 27.25}]  # fmt: skip
     (started / "evaluations.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rounds))
-    assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
+    assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
     out = capsys.readouterr().out
     assert "bounce-allegro-blind-ppo-seed0" in out
     assert "(2.5 M env steps; last evaluation 27.25 bounces, best 31.50 at 1.2 M)" in out
-    assert "time left: 7.4 h for one worker" in out  # (135 M - 2.5 M) / 5000 env steps/s = 26500 s
-    assert main(["olympiad", "cpu", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
+    assert "time left: 9.6 h for one worker" in out  # (175 M - 2.5 M) / 5000 env steps/s = 34500 s
+    assert main(["olympiad", "benchmark", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
                  str(results)]) == 0  # fmt: skip
-    # 26 cells of 5 M and one of 2.5 M over two workers: 67.5 M on the busier one = 13500 s
-    assert "with 2 workers at 5000 env steps/s each (the finished cells' throughput): 3.8 h" in capsys.readouterr().out
-    assert sorted(p.name for p in (tmp_path / "cpu").iterdir()) == [started.name]  # still no study
-    assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
+    # 34 cells of 5 M and one of 2.5 M over two workers: 87.5 M on the busier one = 17500 s
+    assert "with 2 workers at 5000 env steps/s each (the finished cells' throughput): 4.9 h" in capsys.readouterr().out
+    assert sorted(p.name for p in (tmp_path / "benchmark").iterdir()) == [started.name]  # still no study
+    none = ["--results", str(tmp_path / "none")]
+    assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), *none]) == 0
     assert f"time left: unknown: no finished cell's summary in {tmp_path / 'none'}" in capsys.readouterr().out
     timed = [{**r, "train_wall_s": r["env_steps"] / 2500} for r in rounds]  # 2500 env steps/s between its rounds
     (started / "evaluations.jsonl").write_text("".join(json.dumps(r) + "\n" for r in timed))
-    assert main(["olympiad", "cpu", "--dry-run", "--root", str(tmp_path), "--results", str(tmp_path / "none")]) == 0
-    # no finished cell: the started cell's throughput, (140 M - 2.5 M) / 2500 env steps/s = 55000 s
-    assert "time left: 15.3 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
+    assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), *none]) == 0
+    # no finished cell: the started cell's throughput, (180 M - 2.5 M) / 2500 env steps/s = 71000 s
+    assert "time left: 19.7 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
         capsys.readouterr().out
     )
-    assert main(["olympiad", "cpu", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
+    assert main(["olympiad", "benchmark", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
                  str(tmp_path / "none")]) == 0  # fmt: skip
-    # 27 cells of 5 M and one of 2.5 M over two workers: 70 M on the busier one = 28000 s
-    assert "with 2 workers at 2500 env steps/s each (the started cells' last evaluation rounds): 7.8 h" in (
+    # 35 cells of 5 M and one of 2.5 M over two workers: 90 M on the busier one = 36000 s
+    assert "with 2 workers at 2500 env steps/s each (the started cells' last evaluation rounds): 10.0 h" in (
         capsys.readouterr().out
     )
 
@@ -146,7 +147,7 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
 def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():
     from roto.olympiad.cell import cell_spec
 
-    plan = load_plan("variants_bounce")
+    plan = plan_named("variants_bounce")
     force = cell_spec(plan, Cell("bounce", "shadow", "blind", "force_touch", 1))
     binary = cell_spec(plan, Cell("bounce", "shadow", "blind", "ppo", 1))
     assert force.env.touch == "force" and binary.env.touch == "binary" and force.env.seed == 1
@@ -155,13 +156,13 @@ def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agent
         plan.variants["force_touch"].for_task("bounce").label == "bounce_cpu + ppo.entropy_coef=0.004, env.touch=force"
     )
     assert load_plan("paper").variants["ppo"].for_task("bounce").roto_agent == "ppo"
-    assert load_plan("cpu").variants["ppo"].for_task("bounce").roto_agent is None  # the swept critic is not roto's PPO
+    assert plan_named("cpu").variants["ppo"].for_task("bounce").roto_agent is None  # the swept critic is not roto's PPO
 
 
 def test_robot_in_an_override_becomes_each_cells_hand():
     from roto.olympiad.cell import cell_spec
 
-    plan = load_plan("baoding_v1_cpu")
+    plan = plan_named("baoding_v1_cpu")
     cells = (("shadow", "task_critic_replay", 0.25), ("orca", "task_critic_more_aids_low_noise", 0.5))
     for robot, variant, share in cells:
         spec = cell_spec(plan, Cell("baoding", robot, "blind", variant, 1))
@@ -173,7 +174,7 @@ def test_robot_in_an_override_becomes_each_cells_hand():
         ("orca", "task_critic_more_aids_low_noise"),
     }
     lite = cell_spec(plan, Cell("baoding", "shadow_lite", "blind", "task_critic_more_aids", 0))
-    more_aids = load_plan("baoding_v1_more_aids")
+    more_aids = plan_named("baoding_v1_more_aids")
     same = cell_spec(more_aids, next(c for c in more_aids.cells if c.variant == "all_three"))
     assert lite.differences(same) == {}  # the all_three run continues as this plan's cell
     assert all(f"{c.robot}_preswap" in packaged_banks() for c in plan.cells)
@@ -204,7 +205,7 @@ grids:
 def test_the_more_aids_plan_adds_each_aid_to_the_recipe_for_shadow_lite():
     from roto.olympiad.cell import cell_spec
 
-    plan = load_plan("baoding_v1_more_aids")
+    plan = plan_named("baoding_v1_more_aids")
     specs = {c.variant: cell_spec(plan, c) for c in plan.cells if c.robot == "shadow_lite"}
     assert len(specs) == 4
     assert all(
@@ -233,8 +234,8 @@ def test_the_more_aids_probe_of_a_hand_trains_as_its_20m_cell_does(robot, probe_
     """The 5 M probe's run continues as the baoding_v1_cpu cell: nothing but the budget differs."""
     from roto.olympiad.cell import cell_spec
 
-    probe = cell_spec(load_plan("baoding_v1_more_aids"), Cell("baoding", robot, "blind", probe_variant, 0))
-    cell = cell_spec(load_plan("baoding_v1_cpu"), Cell("baoding", robot, "blind", cell_variant, 0))
+    probe = cell_spec(plan_named("baoding_v1_more_aids"), Cell("baoding", robot, "blind", probe_variant, 0))
+    cell = cell_spec(plan_named("baoding_v1_cpu"), Cell("baoding", robot, "blind", cell_variant, 0))
     assert probe.differences(cell) == {} and probe.env.aids.replayed_starts.bank == f"{robot}_preswap"
     assert (probe.steps, cell.steps) == (5_000_000, 20_000_000)
 
@@ -242,7 +243,7 @@ def test_the_more_aids_probe_of_a_hand_trains_as_its_20m_cell_does(robot, probe_
 def test_the_low_noise_variant_differs_from_all_three_only_in_the_policy_std():
     from roto.olympiad.cell import cell_spec
 
-    plan = load_plan("baoding_v1_more_aids")
+    plan = plan_named("baoding_v1_more_aids")
     low = cell_spec(plan, Cell("baoding", "orca", "blind", "all_three_low_noise", 0))
     usual = cell_spec(plan, Cell("baoding", "orca", "blind", "all_three", 0))
     assert low.differences(usual) == {
@@ -265,7 +266,7 @@ def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(plan_nam
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
-    plan = load_plan(plan_name)
+    plan = plan_named(plan_name)
     cell = cell_spec(plan, Cell("baoding", robot, "blind", variant, 0))
     config = ROBOTS[robot].tasks["baoding"].recipe
     packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=1)
@@ -276,7 +277,7 @@ def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_
     """The Shadow's three-aid cell joins baoding_v1_cpu's column; it differs from its one-aid cell in the aids only."""
     from roto.olympiad.cell import cell_spec
 
-    plan, main = load_plan("baoding_v1_shadow_more_aids"), load_plan("baoding_v1_cpu")
+    plan, main = plan_named("baoding_v1_shadow_more_aids"), plan_named("baoding_v1_cpu")
     assert [c.name for c in plan.cells] == [f"baoding-shadow-blind-task_critic_more_aids-seed{s}" for s in (0, 1)]
     variant = "task_critic_more_aids"
     assert plan.variants[variant] == main.variants[variant] and (plan.steps, plan.threads) == (main.steps, main.threads)
@@ -293,7 +294,7 @@ def test_each_ablation_changes_exactly_its_part_of_the_baoding_recipe():
     """The ablations' recipe is the Olympiad's Baoding recipe; every other cell differs from it in one part only."""
     from roto.olympiad.cell import cell_spec
 
-    plan, main = load_plan("baoding_v1_ablations"), load_plan("baoding_v1_cpu")
+    plan, main = plan_named("baoding_v1_ablations"), plan_named("baoding_v1_cpu")
     assert {c.seed for c in plan.cells} == {1} and {c.robot for c in plan.cells} == {"shadow"}
     recipe = cell_spec(plan, Cell("baoding", "shadow", "blind", "recipe", 1))
     assert recipe.differences(cell_spec(main, Cell("baoding", "shadow", "blind", "task_critic_more_aids", 1))) == {}
@@ -320,7 +321,7 @@ def test_the_low_noise_plan_trains_orcas_recipe_on_other_hands_as_the_ablation_d
     """Each cell is ORCA's Olympiad recipe on its hand at 5 M; the Shadow's seed 1 is the ablation's low_noise cell."""
     from roto.olympiad.cell import cell_spec
 
-    plan, main, ablations = (load_plan(n) for n in ("baoding_v1_low_noise", "baoding_v1_cpu", "baoding_v1_ablations"))
+    plan, main, ablations = (plan_named(n) for n in ("baoding_v1_low_noise", "baoding_v1_cpu", "baoding_v1_ablations"))
     variant = "task_critic_more_aids_low_noise"
     assert plan.variants[variant] == main.variants[variant] and plan.steps == ablations.steps == 5_000_000
     cells = [(c.robot, c.seed) for c in plan.cells]
@@ -337,7 +338,7 @@ def test_the_low_noise_plan_trains_orcas_recipe_on_other_hands_as_the_ablation_d
 def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_starts():
     from roto.olympiad.cell import cell_spec
 
-    plan = load_plan("baoding_v1_more_aids")
+    plan = plan_named("baoding_v1_more_aids")
     cycle = cell_spec(plan, Cell("baoding", "allegro", "blind", "cycle_low_noise", 0))
     low = cell_spec(plan, Cell("baoding", "allegro", "blind", "all_three_low_noise", 0))
     bank = "allegro_cycle"
@@ -351,7 +352,7 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
-    plan = load_plan("baoding_v1_round")
+    plan = plan_named("baoding_v1_round")
     recipe = build_run_spec("baoding", "orca", "blind", "baoding_cpu_orca", [], plan.steps, num_envs=128, threads=1)
     bank, round_bank = (
         recipe.env.aids.replayed_starts.bank,
@@ -375,7 +376,7 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
         seed = {"env.seed": (cell.seed, 0)} if cell.seed else {}
         assert cell_spec(plan, cell).differences(recipe) == {**expected[cell.variant], **seed}
     assert round_bank in packaged_banks()
-    long = load_plan("baoding_v1_orca_round")  # the round cells' continuation: the same runs, longer
+    long = plan_named("baoding_v1_orca_round")  # the round cells' continuation: the same runs, longer
     assert long.steps == 20_000_000
     assert [c.name for c in long.cells] == [c.name for c in plan.cells if c.variant == "round_bank_round_swaps"]
     for cell in long.cells:  # training the same (the budget aside), so each 5 M run continues
@@ -390,7 +391,7 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
-    plan = load_plan("baoding_v1_shadow_round")
+    plan = plan_named("baoding_v1_shadow_round")
     assert [c.name for c in plan.cells] == ["baoding-shadow-blind-round-seed3"] and plan.steps == 5_000_000
     recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu_shadow", [], plan.steps, num_envs=128, threads=1)
     round_bank = "shadow_round_preswap"
@@ -437,7 +438,7 @@ def test_the_dry_run_line_shows_the_last_evaluations_path_metrics_where_it_has_t
 def test_the_benchmark_plan_trains_every_hand_and_mode_with_its_record_s_recipe_on_three_seeds():
     from roto.olympiad.cell import cell_spec
 
-    plan, cpu = load_plan("benchmark"), load_plan("cpu")
+    plan, cpu = load_plan("benchmark"), plan_named("cpu")
     assert {(c.robot, c.obs, c.seed) for c in plan.cells} == {
         (robot, obs, seed) for robot in ROBOTS for obs in ("blind", "state", "proprio") for seed in (0, 1, 2)
     }

@@ -180,6 +180,6 @@ def test_cli_olympiad_with_two_workers_on_the_real_env_then_results(tmp_path, ca
 def test_cli_olympiad_refuses_a_thread_count_below_one_by_value(tmp_path, capsys):
     from roto.cli import main
 
-    assert main(["olympiad", "cpu", "--root", str(tmp_path), "--threads", "0"]) == 2
+    assert main(["olympiad", "benchmark", "--root", str(tmp_path), "--threads", "0"]) == 2
     assert "--threads must be >= 1, got 0" in capsys.readouterr().err
     assert not any(tmp_path.iterdir())

@@ -45,7 +45,7 @@ def test_a_new_hand_gets_its_ids_its_plan_recipe_and_its_table_row(toy):
     from roto.registry import gym_id
 
     assert gym_id("bounce", "toy") == "roto/Bounce-Toy-v0"
-    variant = load_plan("cpu").variants["ppo"]
+    variant = load_plan("benchmark").variants["ppo"]
     assert variant.agent_for("bounce", "toy")[0] == "bounce_cpu_orca"  # its record's recipe
     scores = {("bounce", robot, "blind", "ppo"): torch.ones(2).numpy() for robot in ("toy", "shadow")}
     rows = [line for line in markdown_table(scores).splitlines() if line.startswith("| ")]

@@ -93,7 +93,7 @@ CLI_URLS = [
 @pytest.mark.parametrize("command", ["show", "olympiad"])
 @pytest.mark.parametrize("url", CLI_URLS)
 def test_the_cli_never_prints_a_password(url, command, tmp_path, capsys):
-    args = ["sweep", "show", "--study", "s"] if command == "show" else ["olympiad", "cpu", "--dry-run"]
+    args = ["sweep", "show", "--study", "s"] if command == "show" else ["olympiad", "benchmark", "--dry-run"]
     assert main([*args, "--root", str(tmp_path), "--storage", url]) == 2
     captured = capsys.readouterr()
     lines = captured.err.strip().splitlines()
@@ -158,7 +158,7 @@ def _launch(command: str, tmp_path, monkeypatch) -> int:
     else:
         monkeypatch.setattr("roto.olympiad.worker.open_olympiad", lambda plan, root, url: (None, None))
         monkeypatch.setattr("roto.olympiad.worker.enqueue_missing", lambda study, plan, results: [])
-        args = ["olympiad", "cpu"]
+        args = ["olympiad", "benchmark"]
     return main([*args, "--root", str(tmp_path), "--workers", "2", "--storage", WORKER_URL])
 
 
