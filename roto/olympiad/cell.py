@@ -4,8 +4,9 @@ The run directory is ``<root>/<plan>/<cell>`` (an ordinary run: ``roto eval``, `
 ``roto train --resume`` work on it); a cell whose run has a checkpoint continues from it. The
 summary, ``<results>/<cell>.json``, is small enough to commit: the evaluation curve, the training
 scalars between evaluations (the policy's action std, the training episodes' return, length and
-task metrics), the final and best policies' evaluations over the plan's episodes (per-episode
-returns and task metrics included), the training wall time and the commit. ``roto results`` reads
+task metrics), the training aids its run used, the final and best policies' evaluations over the
+plan's episodes (per-episode returns and task metrics included), the training wall time and the
+commit. ``roto results`` reads
 only summaries, so cells trained on other machines or in other sittings combine.
 """
 
@@ -120,6 +121,7 @@ def run_cell(
         "task_version": get_task(cell.task).version,
         "plan": plan.name,
         "agent": {"label": entry.label, "roto_agent": entry.roto_agent},
+        "training_aids": trainer.spec.env.aids.to_dict(),
         "commit": commit,
         "run_dir": str(run_dir),
         "env_steps": trainer.env_steps,

@@ -45,6 +45,16 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     )
     r.add_argument("--out", default=None, help="folder to write results.md, results_*.csv and curves_*.png into")
     r.add_argument("--root", default="runs/olympiad")
+    r.add_argument(
+        "--plan", default=None, help="with a folder of summaries: the plan whose configs name its columns and manifest"
+    )
+    r.add_argument(
+        "--pages",
+        nargs="+",
+        default=None,
+        metavar="PAGE",
+        help="refresh the generated tables of these markdown pages (docs/results.md, README.md) and exit",
+    )
     add_results_submission_flags(r)
     r.set_defaults(func=cmd_results)
     add_submit_parser(sub)
@@ -194,22 +204,42 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
     return "\n".join(lines)
 
 
+def cmd_pages(pages: list[str]) -> int:
+    """Rewrite each page's generated tables (``roto.olympiad.reference_tables.refresh_blocks``;
+    sources relative to the current directory, the repository's root)."""
+    from roto.olympiad.reference_tables import refresh_blocks
+    from roto.result_files import write_text_atomic
+
+    texts = {page: pathlib.Path(page).read_text(encoding="utf-8") for page in pages}  # every page read first
+    fresh = {page: refresh_blocks(text, ".") for page, text in texts.items()}  # then every table made
+    changed = [page for page in pages if fresh[page] != texts[page]]
+    for page in changed:
+        write_text_atomic(page, fresh[page])
+    print(json.dumps({"pages": pages, "changed": changed}))
+    return 0
+
+
 def cmd_results(args: argparse.Namespace) -> int:
     """Write the tables and curves (with ``--check FILE``: check one submission, write nothing)."""
     from roto.olympiad.plan import load_plan
     from roto.olympiad.results_page import write_results
 
     if args.check is not None:
-        if args.source or args.out or args.submissions:
+        if args.source or args.out or args.submissions or args.pages:
             raise ValueError("roto results --check FILE checks one submission and writes nothing; give it alone")
         return cmd_check(args.check)
+    if args.pages is not None:
+        if args.source or args.out or args.submissions:
+            raise ValueError("roto results --pages PAGE... refreshes the pages' generated tables; give it alone")
+        return cmd_pages(args.pages)
     if args.source is None or args.out is None:
         raise ValueError("roto results needs SOURCE (a plan or a folder of summaries) and --out FOLDER")
     source = pathlib.Path(args.source)
-    if source.is_dir():
-        folder, name = source, ""
-    else:
-        name = load_plan(args.source).name
-        folder = pathlib.Path(args.root) / name / "results"
-    print(json.dumps(write_results(folder, args.out, plan=name, submissions=args.submissions)))
+    plan_source = args.plan if source.is_dir() else args.source
+    plan = load_plan(plan_source) if plan_source else None
+    folder = source if source.is_dir() else pathlib.Path(args.root) / plan.name / "results"
+    result = write_results(
+        folder, args.out, plan=plan.name if plan else "", plan_read=plan, submissions=args.submissions
+    )
+    print(json.dumps(result))
     return 0

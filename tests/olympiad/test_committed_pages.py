@@ -7,6 +7,7 @@ import pathlib
 
 import pytest
 
+from roto.olympiad.reference_tables import refresh_blocks
 from roto.olympiad.results import read_summaries
 from roto.olympiad.results_page import results_markdown
 
@@ -34,10 +35,22 @@ PAGES = sorted(
 )
 
 
+PLANS = {"benchmarks/results/benchmark/tables": "benchmark"}
+"""Pages whose columns are named by a plan (``roto results ... --plan``); the others by their summaries."""
+
+
 @pytest.mark.parametrize("page", PAGES, ids=[str(p.parent.relative_to(ROOT)) for p in PAGES])
 def test_a_committed_page_is_what_its_summaries_generate(page):
     summaries = read_summaries(summaries_of(page))
-    assert page.read_text() == results_markdown(summaries), f"regenerate {page.parent}"
+    plan = PLANS.get(str(page.parent.relative_to(ROOT)), "")
+    assert page.read_text() == results_markdown(summaries, plan), f"regenerate {page.parent}"
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/results.md"])
+def test_the_generated_tables_of_a_page_are_what_their_summaries_generate(page):
+    text = (ROOT / page).read_text()
+    assert "<!-- roto results: " in text
+    assert refresh_blocks(text, ROOT) == text, f"run: roto results --pages {page}"
 
 
 def test_the_pages_are_found():

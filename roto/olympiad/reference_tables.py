@@ -1,0 +1,180 @@
+"""The results reference's tables (docs/results.md, the README), generated from cell summaries.
+
+``task_table``: one row per (hand, obs mode, variant) of a task: the config it trained, the seeds,
+the task's lead measure (Baoding: round rotations; Bounce: bounces) as mean ± std, IQM with its
+95 % interval and per-seed values, roto's swap count beside Baoding's, the hand's reference and
+roto's published figures on the Shadow. ``overview_table``: the README's few lines, hands by
+(task, obs mode). ``refresh_blocks`` rewrites the generated blocks of a markdown page (between
+``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] -->`` and ``<!-- /roto results -->``) from their folders.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import re
+from collections.abc import Callable
+
+import numpy as np
+
+from roto.envs.observations import OBS_MODES
+from roto.olympiad.cell import cell_spec
+from roto.olympiad.path_results import with_derived_means
+from roto.olympiad.plan import Cell, Plan, load_plan
+from roto.olympiad.results import cell_statistics, read_summaries
+from roto.robots import ROBOTS
+from roto.tasks import TASKS, get_task
+
+PUBLISHED = {
+    ("bounce", "blind"): "v1 PPO 69; 2.0 about 80",
+    ("bounce", "proprio"): "v1 PPO 53",
+    ("bounce", "state"): "2.0 close to 100",
+    ("baoding", "blind"): "v1 PPO 5.1 (rotations); 2.0 up to 13 (best seed)",
+    ("baoding", "proprio"): "v1 PPO 0.1 (rotations)",
+    ("baoding", "state"): "2.0 up to 35",
+}
+"""roto's published Shadow figures at 200 M env steps by (task, obs mode) (docs/spec.md §9): roto
+v1's PPO (mean of 5 seeds) and the roto 2.0 paper; other agents than roto's, set beside ours."""
+
+Row = tuple[str, str, str]  # robot, obs, variant
+
+
+def lead_measure(task: str) -> str:
+    """The measure a task's results lead with: its selection metric, else its headline metric."""
+    spec = get_task(task)
+    return spec.selection_metric or spec.headline_metric
+
+
+def _scores(summaries: list[dict], task: str, measure: str) -> dict[Row, np.ndarray | None]:
+    """{(robot, obs, variant): (seeds,) ``measure`` of each seed's best policy, seeds in order;
+    None where a seed's summary neither holds nor can recompute it}."""
+    found: dict[Row, list[tuple[int, float | None]]] = {}
+    for s in summaries:
+        if s["task"] == task:
+            value = with_derived_means(task, s["best"]).get(f"{measure}_mean")
+            found.setdefault((s["robot"], s["obs"], s["variant"]), []).append((s["seed"], value))
+    return {
+        row: None if any(v is None for _, v in runs) else np.array([v for _, v in sorted(runs)])
+        for row, runs in found.items()
+    }
+
+
+def _row_order(row: Row) -> tuple[int, int, str]:
+    robots, modes = list(ROBOTS), list(OBS_MODES)
+    robot, obs, variant = row
+    return (robots.index(robot) if robot in robots else len(robots), modes.index(obs), variant)
+
+
+def config_label(summary: dict, plan: Plan | None = None) -> str:
+    """The config a cell trained: with ``plan``, the config and overrides the plan trains its hand
+    with; else the label its summary records, else its variant's name."""
+    task, variant = summary["task"], summary["variant"]
+    if plan is not None and variant in plan.variants:
+        config, overrides = plan.variants[variant].agent_for(task, summary["robot"])
+        config = config or f"{task} (roto's)"
+        return " + ".join([config, ", ".join(overrides)] if overrides else [config])
+    return (summary.get("agent") or {}).get("label") or variant
+
+
+def training_aids(summary: dict, plan: Plan | None = None) -> str:
+    """The training aids a cell's run trained with: as its summary records them, else as ``plan``
+    trains the cell, else "not recorded"; "none" when it used none."""
+    if "training_aids" in summary:
+        names = sorted(summary["training_aids"])
+    elif plan is not None and summary["variant"] in plan.variants:
+        cell = Cell(*(summary[key] for key in ("task", "robot", "obs", "variant", "seed")))
+        names = sorted(cell_spec(plan, cell).env.aids.active())
+    else:
+        return "not recorded"
+    return ", ".join(names) or "none"
+
+
+def _statistics(scores: np.ndarray | None) -> tuple[str, str, str]:
+    """(mean ± std, IQM [95 % interval], per-seed values) of one row's seeds."""
+    if scores is None:
+        return "not measured", "", ""
+    stats = cell_statistics(scores)
+    per_seed = ", ".join(f"{v:.1f}" for v in scores)
+    if stats["n"] == 1:
+        return f"{stats['mean']:.1f}", "", per_seed
+    if stats["n"] < 3:  # an IQM and interval of one or two values say nothing more than the values
+        return f"{stats['mean']:.1f} ± {stats['std']:.1f}", "", per_seed
+    interval = f"{stats['iqm']:.1f} [{stats['iqm_low']:.1f}, {stats['iqm_high']:.1f}]"
+    return f"{stats['mean']:.1f} ± {stats['std']:.1f}", interval, per_seed
+
+
+def task_table(summaries: list[dict], task: str, plan: Plan | None = None) -> str:
+    """Markdown: one row per (hand, obs mode, variant) of ``task`` in ``summaries`` (best policies,
+    the evaluation episodes' mean per seed), each naming its config (``plan``: as that plan trains it)."""
+    spec, lead = get_task(task), lead_measure(task)
+    scores = _scores(summaries, task, lead)
+    count = _scores(summaries, task, spec.headline_metric) if lead != spec.headline_metric else None
+    labels = {(s["robot"], s["obs"], s["variant"]): config_label(s, plan) for s in summaries if s["task"] == task}
+    seeds = {
+        row: sorted(s["seed"] for s in summaries if (s["task"], s["robot"], s["obs"], s["variant"]) == (task, *row))
+        for row in scores
+    }
+    aids = {}
+    for s in summaries:
+        if s["task"] == task:
+            aids.setdefault((s["robot"], s["obs"], s["variant"]), set()).add(training_aids(s, plan))
+    head = ["hand", "obs", "agent config", "training aids", "seeds", f"{lead}: mean ± std", "IQM [95 % CI]", "per seed"]
+    head += [f"roto's {spec.headline_metric}"] if count is not None else []
+    head += [f"{spec.reference_name} ({spec.headline_metric})", "roto published (Shadow, 200 M)"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for row in sorted(scores, key=_row_order):
+        robot, obs, _ = row
+        cells = [robot, obs, f"`{labels[row]}`", "; ".join(sorted(aids[row])), ", ".join(map(str, seeds[row]))]
+        cells += _statistics(scores[row])
+        if count is not None:
+            cells.append(_statistics(count[row])[0])
+        cells.append(f"{spec.reference[robot]}" if robot in spec.reference else "")
+        cells.append(PUBLISHED.get((task, obs), "") if robot == "shadow" else "")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def overview_table(summaries: list[dict]) -> str:
+    """Markdown for the README: hands as rows, (task, obs mode) as columns, each cell the task's lead
+    measure (``lead_measure``: bounces, Baoding's round rotations) as the mean over seeds of the best
+    policies, and the seed count."""
+    order = list(TASKS)
+    columns = sorted(
+        {(s["task"], s["obs"]) for s in summaries}, key=lambda c: (order.index(c[0]), list(OBS_MODES).index(c[1]))
+    )
+    robots = sorted({s["robot"] for s in summaries}, key=lambda r: _row_order((r, "blind", "")))
+    head = ["hand", *(f"{task} {obs}" for task, obs in columns)]  # the measures: each task's lead_measure
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for robot in robots:
+        cells = [robot]
+        for task, obs in columns:
+            rows = {
+                row: v for row, v in _scores(summaries, task, lead_measure(task)).items() if row[:2] == (robot, obs)
+            }
+            values = [v for v in rows.values() if v is not None]
+            cells.append(" / ".join(f"{v.mean():.1f} (n={v.size})" for v in values))
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+TABLES: dict[str, Callable[[list[dict], Plan | None], str]] = {
+    "bounce": lambda summaries, plan: task_table(summaries, "bounce", plan),
+    "baoding": lambda summaries, plan: task_table(summaries, "baoding", plan),
+    "overview": lambda summaries, plan: overview_table(summaries),
+}
+"""The kinds of generated block a page may hold, each a table of its source's summaries."""
+BLOCK = re.compile(r"(<!-- roto results: (\S+) (\S+)(?: plan=(\S+))? -->\n)(.*?)(<!-- /roto results -->)", re.DOTALL)
+
+
+def refresh_blocks(text: str, root: str | pathlib.Path) -> str:
+    """``text`` with every generated block's table made again from its source folders (relative to
+    ``root``, the repository; several joined by commas); ValueError naming an unknown kind or a
+    folder without summaries."""
+
+    def table(match: re.Match) -> str:
+        opening, kind, source, plan = match.group(1, 2, 3, 4)
+        if kind not in TABLES:
+            raise ValueError(f"generated block {opening.strip()!r}: unknown kind {kind!r}; valid: {sorted(TABLES)}")
+        summaries = [s for folder in source.split(",") for s in read_summaries(pathlib.Path(root) / folder)]
+        return f"{opening}{TABLES[kind](summaries, load_plan(plan) if plan else None)}\n{match.group(6)}"
+
+    return BLOCK.sub(table, text)

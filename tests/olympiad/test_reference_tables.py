@@ -1,0 +1,133 @@
+import csv
+import json
+
+import pytest
+
+from roto.cli import main
+from roto.olympiad.manifest import manifest_rows
+from roto.olympiad.plan import load_plan
+from roto.olympiad.reference_tables import overview_table, refresh_blocks, task_table
+
+
+def summary(task, robot, obs, variant, seed, best, **extra):
+    return {
+        "task": task,
+        "robot": robot,
+        "obs": obs,
+        "variant": variant,
+        "seed": seed,
+        "plan": "toy",
+        "commit": "abc1234",
+        "evaluations": [],
+        "final": best,
+        "best": best,
+        **extra,
+    }
+
+
+BOUNCES = [10.0, 20.0, 30.0, 100.0]
+SUMMARIES = [
+    *[summary("bounce", "shadow", "blind", "ppo", s, {"bounces_mean": b}) for s, b in enumerate(BOUNCES)],
+    summary("bounce", "allegro", "state", "ppo", 0, {"bounces_mean": 4.5}, task_version=0),
+    *[
+        summary(
+            "baoding",
+            "shadow",
+            "blind",
+            "turn",
+            s,
+            {"rotations_mean": r, "round_rotations_mean": r - 1},
+            agent={"label": "baoding_cpu_shadow + turn", "roto_agent": None},
+            training_aids={"turn_shaping": {"per_turn": 20.0}, "tolerance": {}},
+        )
+        for s, r in ((0, 4.0), (1, 6.0))
+    ],
+]
+
+
+def rows_of(table: str) -> dict[tuple[str, str], list[str]]:
+    rows = [line.strip("|").split(" | ") for line in table.splitlines()[2:]]
+    return {(row[0].strip(), row[1].strip()): [cell.strip() for cell in row] for row in rows}
+
+
+def test_a_task_table_gives_each_hand_and_mode_its_statistics_seeds_and_references():
+    table = task_table(SUMMARIES, "bounce")
+    assert table.splitlines()[0].startswith("| hand | obs | agent config | training aids | seeds | bounces: mean ± std")
+    shadow = rows_of(table)[("shadow", "blind")]
+    # 10, 20, 30, 100: mean 40, population std sqrt(1250) = 35.4, IQM the mean of 20 and 30
+    assert shadow[2:8] == ["`ppo`", "not recorded", "0, 1, 2, 3", "40.0 ± 35.4", shadow[6], "10.0, 20.0, 30.0, 100.0"]
+    assert shadow[6].startswith("25.0 [") and shadow[-2:] == ["27.9", "v1 PPO 69; 2.0 about 80"]
+    allegro = rows_of(table)[("allegro", "state")]
+    assert allegro[5:8] == ["4.5", "", "4.5"] and allegro[-2:] == ["11.8", ""]  # one seed: no spread, no IQM
+    assert list(rows_of(table)) == [("shadow", "blind"), ("allegro", "state")]  # the hand registry's order
+
+
+def test_baoding_leads_with_round_rotations_and_names_roto_s_count_and_the_aids_beside():
+    table = task_table(SUMMARIES, "baoding")
+    assert "| round_rotations: mean ± std | IQM [95 % CI] | per seed | roto's rotations |" in table.splitlines()[0]
+    row = rows_of(table)[("shadow", "blind")]
+    assert row[2:9] == [
+        "`baoding_cpu_shadow + turn`",
+        "tolerance, turn_shaping",
+        "0, 1",
+        "4.0 ± 1.0",
+        "",
+        "3.0, 5.0",
+        "5.0 ± 1.0",
+    ]
+
+
+def test_a_plan_names_each_hands_config_and_aids():
+    ppo = [summary("bounce", r, "blind", "ppo", 0, {"bounces_mean": 1.0}) for r in ("shadow", "orca")]
+    rows = rows_of(task_table(ppo, "bounce", load_plan("benchmark")))
+    assert rows[("shadow", "blind")][2:4] == ["`bounce_cpu_quickstart`", "none"]
+    assert rows[("orca", "blind")][2] == "`bounce_cpu_orca`"
+
+
+def test_the_overview_is_a_few_short_lines():
+    table = overview_table(SUMMARIES)
+    lines = table.splitlines()
+    assert lines[0] == "| hand | bounce blind | bounce state | baoding blind |"
+    assert lines[2] == "| shadow | 40.0 (n=4) |  | 4.0 (n=2) |"  # Baoding's round rotations
+    assert lines[3] == "| allegro |  | 4.5 (n=1) |  |" and len(lines) == 4
+
+
+def write_folder(path, summaries):
+    path.mkdir()
+    for s in summaries:
+        (path / f"{s['task']}-{s['robot']}-{s['obs']}-{s['variant']}-seed{s['seed']}.json").write_text(json.dumps(s))
+
+
+def test_pages_refresh_their_generated_blocks_from_one_or_more_folders(tmp_path, monkeypatch, capsys):
+    write_folder(tmp_path / "a", SUMMARIES[:5])
+    write_folder(tmp_path / "b", SUMMARIES[5:])
+    page = tmp_path / "page.md"
+    page.write_text("# x\n\n<!-- roto results: overview a,b -->\nstale\n<!-- /roto results -->\n\nprose\n")
+    monkeypatch.chdir(tmp_path)
+    assert main(["results", "--pages", "page.md"]) == 0
+    assert json.loads(capsys.readouterr().out) == {"pages": ["page.md"], "changed": ["page.md"]}
+    text = page.read_text()
+    assert "stale" not in text and overview_table(SUMMARIES) in text and text.endswith("\n\nprose\n")
+    assert refresh_blocks(text, tmp_path) == text
+    assert main(["results", "--pages", "page.md"]) == 0 and '"changed": []' in capsys.readouterr().out
+    page.write_text("<!-- roto results: pie a -->\n<!-- /roto results -->\n")
+    assert main(["results", "--pages", "page.md"]) == 2
+    assert "unknown kind 'pie'; valid: ['baoding', 'bounce', 'overview']" in capsys.readouterr().err
+
+
+def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_path):
+    rows = {row["cell"]: row for row in manifest_rows(SUMMARIES)}
+    turn = rows["baoding-shadow-blind-turn-seed1"]
+    assert turn["config"] == "baoding_cpu_shadow + turn" and turn["training_aids"] == "tolerance, turn_shaping"
+    assert turn["task_version"] == "not recorded" and rows["bounce-allegro-state-ppo-seed0"]["task_version"] == "0"
+    assert turn["commit"] == "abc1234" and list(rows) == sorted(rows)
+    write_folder(tmp_path / "cells", SUMMARIES)
+    assert main(["results", str(tmp_path / "cells"), "--out", str(tmp_path / "out")]) == 0
+    written = list(csv.DictReader((tmp_path / "out" / "manifest.csv").open()))
+    assert [row["cell"] for row in written] == list(rows)
+
+
+@pytest.mark.parametrize("flags", [["x", "--pages", "p.md"], ["--pages", "p.md", "--out", "o"]])
+def test_pages_stand_alone(flags, capsys):
+    assert main(["results", *flags]) == 2
+    assert "refreshes the pages' generated tables; give it alone" in capsys.readouterr().err
