@@ -98,6 +98,18 @@ def json_kind(value: Any) -> str:
     return next((f"{name} ({value!r:.40})" for kind, name in kinds if isinstance(value, kind)), "null")
 
 
+def require_fields(where: str, data: dict, fields: dict[str, type], expected: str = "it needs") -> None:
+    """Refuse ``data`` (the JSON object ``where`` names) lacking one of ``fields`` ({name: its
+    Python type: str, int, list or dict}) or holding one of another type (a boolean is no integer);
+    the message names the field, what was expected and what was found."""
+    missing = [key for key in fields if key not in data]
+    if missing:
+        raise ValueError(f"{where} lacks the field(s) {missing}; {expected} {list(fields)}")
+    for key, kind in fields.items():
+        if not isinstance(data[key], kind) or isinstance(data[key], bool):
+            raise ValueError(f"{where}: {key!r} should be {JSON_TYPES[kind]}, found {json_kind(data[key])}")
+
+
 def check_summary(path: str | pathlib.Path, summary: Any) -> dict:
     """``summary``, read from ``path``, if it has what ``roto results`` reads (``SUMMARY_FIELDS``, and
     the task metric's mean in its final, best and evaluation records); else a ValueError naming the
@@ -106,12 +118,7 @@ def check_summary(path: str | pathlib.Path, summary: Any) -> dict:
     if not isinstance(summary, dict):
         raise ValueError(f"{where} holds {json_kind(summary)}, not an object (a cell summary of roto olympiad)")
     check_format("cell summary", summary.get(FORMAT_KEY), where)
-    missing = [key for key in SUMMARY_FIELDS if key not in summary]
-    if missing:
-        raise ValueError(f"{where} lacks the field(s) {missing}; a cell summary has {list(SUMMARY_FIELDS)}")
-    for key, kind in SUMMARY_FIELDS.items():
-        if not isinstance(summary[key], kind) or isinstance(summary[key], bool):
-            raise ValueError(f"{where}: {key!r} should be {JSON_TYPES[kind]}, found {json_kind(summary[key])}")
+    require_fields(where, summary, SUMMARY_FIELDS, "a cell summary has")
     try:
         mean = f"{metric(summary['task'])}_mean"
     except ValueError as error:  # an unknown task, named with the valid ones

@@ -21,7 +21,7 @@ from roto.artifact_formats import FORMAT_KEY, check_format, format_stamp
 from roto.envs.config import EnvConfig
 from roto.envs.observations import OBS_MODES, TOUCH_MODES
 from roto.eval.protocol import EVAL_EPISODES, EVAL_SEED
-from roto.olympiad.results import json_kind
+from roto.olympiad.results import json_kind, require_fields
 from roto.result_files import read_json
 from roto.robots import ROBOTS
 from roto.tasks import TASKS, get_task
@@ -44,17 +44,6 @@ FIELDS = {
     "seeds": list,
 }
 """The top-level fields of a submission, with their JSON types."""
-JSON_TYPES = {str: "a string", int: "an integer", list: "an array", dict: "an object"}
-
-
-def _require(where: str, data: Mapping, fields: Mapping[str, type]) -> None:
-    """Refuse ``data`` (the object ``where`` names) lacking one of ``fields`` or holding another type."""
-    missing = [key for key in fields if key not in data]
-    if missing:
-        raise ValueError(f"{where} lacks the field(s) {missing}; it has {list(fields)}")
-    for key, kind in fields.items():
-        if not isinstance(data[key], kind) or isinstance(data[key], bool):
-            raise ValueError(f"{where}: {key!r} should be {JSON_TYPES[kind]}, found {json_kind(data[key])}")
 
 
 def _choice(where: str, field: str, value: str, valid: list[str]) -> None:
@@ -75,7 +64,7 @@ def check_submission(path: str | pathlib.Path, data: Any) -> dict:
     where = f"submission {str(path)!r}"
     if not isinstance(data, dict):
         raise ValueError(f"{where} holds {json_kind(data)}, not an object (docs/submissions.md)")
-    _require(where, data, FIELDS)
+    require_fields(where, data, FIELDS, "a submission has")
     check_format("submission", data[FORMAT_KEY], where)
     _choice(where, "task", data["task"], sorted(TASKS))
     version = get_task(data["task"]).version
@@ -97,7 +86,7 @@ def check_submission(path: str | pathlib.Path, data: Any) -> dict:
 
 
 def _check_method(where: str, method: dict) -> None:
-    _require(f"{where}: 'method'", method, {"name": str, "description": str})
+    require_fields(f"{where}: 'method'", method, {"name": str, "description": str})
     if not METHOD_NAME.fullmatch(method["name"]):
         raise ValueError(
             f"{where}: method 'name' {method['name']!r} should be 1-40 characters of a-z, 0-9, '_', '.', '-' "
@@ -110,7 +99,7 @@ def _check_method(where: str, method: dict) -> None:
 def _check_evaluation(where: str, evaluation: dict) -> int:
     """The episodes per seed of a submission's ``evaluation``, if it followed roto's protocol."""
     where = f"{where}: 'evaluation'"
-    _require(where, evaluation, {"episodes": int, "seed": int, "training_aids": dict})
+    require_fields(where, evaluation, {"episodes": int, "seed": int, "training_aids": dict})
     if evaluation["episodes"] < EVAL_EPISODES:
         raise ValueError(
             f"{where}: 'episodes' is {evaluation['episodes']}; roto's protocol evaluates >= {EVAL_EPISODES} episodes"
@@ -133,7 +122,7 @@ def _check_seeds(where: str, seeds: list, measures: tuple[str, ...], episodes: i
         here = f"{where}: seeds[{i}]"
         if not isinstance(entry, dict):
             raise ValueError(f"{here} should be an object, found {json_kind(entry)}")
-        _require(here, entry, {"seed": int, "per_episode": dict})
+        require_fields(here, entry, {"seed": int, "per_episode": dict})
         if entry["seed"] in seen:
             raise ValueError(f"{here}: training seed {entry['seed']} appears twice; each seed is one training run")
         seen.add(entry["seed"])
