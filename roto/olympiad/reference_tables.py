@@ -4,8 +4,10 @@
 the task's lead measure (Baoding: round rotations; Bounce: bounces) as mean ± std, IQM with its
 95 % interval and per-seed values, roto's swap count beside Baoding's, the hand's reference and
 roto's published figures on the Shadow. ``overview_table``: the README's few lines, hands by
-(task, obs mode). ``refresh_blocks`` rewrites the generated blocks of a markdown page (between
-``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] -->`` and ``<!-- /roto results -->``) from their folders.
+(task, obs mode). ``touch_table``: blind minus proprio-only agents per (task, hand).
+``refresh_blocks`` rewrites the generated blocks of a markdown page (between
+``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] -->`` and ``<!-- /roto results -->``)
+from their folders.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from roto.olympiad.cell import cell_spec
 from roto.olympiad.path_results import with_derived_means
 from roto.olympiad.plan import Cell, Plan, load_plan
 from roto.olympiad.results import cell_statistics, read_summaries
+from roto.olympiad.stats import difference_ci
 from roto.robots import ROBOTS
 from roto.tasks import TASKS, get_task
 
@@ -156,10 +159,37 @@ def overview_table(summaries: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def touch_table(summaries: list[dict]) -> str:
+    """Markdown: touch's effect per (task, hand): the blind agents' lead measure minus the
+    proprio-only agents' (best policies, mean over seeds; every variant of a mode pooled), with a
+    95 % bootstrap interval of the difference once each side has three seeds or more."""
+    lines = [
+        "| task | hand | blind (seeds) | proprio (seeds) | blind − proprio | 95 % CI |",
+        "|---|---|---|---|---|---|",
+    ]
+    for task in [t for t in TASKS if any(s["task"] == t for s in summaries)]:
+        scores = _scores(summaries, task, lead_measure(task))
+        for robot in sorted({row[0] for row in scores}, key=lambda r: _row_order((r, "blind", ""))):
+            sides = [
+                np.concatenate([v for row, v in scores.items() if row[:2] == (robot, obs) and v is not None] or [[]])
+                for obs in ("blind", "proprio")
+            ]
+            if not all(side.size for side in sides):
+                continue
+            blind, proprio = sides
+            interval = "needs three seeds each"
+            if min(blind.size, proprio.size) >= 3:
+                interval = "[{:.1f}, {:.1f}]".format(*difference_ci(blind, proprio))
+            cells = [task, robot, f"{blind.mean():.1f} ({blind.size})", f"{proprio.mean():.1f} ({proprio.size})"]
+            lines.append("| " + " | ".join([*cells, f"{blind.mean() - proprio.mean():+.1f}", interval]) + " |")
+    return "\n".join(lines)
+
+
 TABLES: dict[str, Callable[[list[dict], Plan | None], str]] = {
     "bounce": lambda summaries, plan: task_table(summaries, "bounce", plan),
     "baoding": lambda summaries, plan: task_table(summaries, "baoding", plan),
     "overview": lambda summaries, plan: overview_table(summaries),
+    "touch": lambda summaries, plan: touch_table(summaries),
 }
 """The kinds of generated block a page may hold, each a table of its source's summaries."""
 BLOCK = re.compile(r"(<!-- roto results: (\S+) (\S+)(?: plan=(\S+))? -->\n)(.*?)(<!-- /roto results -->)", re.DOTALL)

@@ -53,3 +53,21 @@ def probability_of_improvement(x: np.ndarray, y: np.ndarray) -> float:
     greater = (x[:, None, :] > y[None, :, :]).mean(axis=(0, 1))
     ties = (x[:, None, :] == y[None, :, :]).mean(axis=(0, 1))
     return float((greater + 0.5 * ties).mean())
+
+
+def difference_ci(
+    x: np.ndarray, y: np.ndarray, reps: int = 2000, confidence: float = 0.95, seed: int = 0
+) -> tuple[float, float]:
+    """Percentile bootstrap interval of mean(x) - mean(y), each resampled with replacement on its
+    own (two independent groups of runs, e.g. blind and proprio-only agents' seeds).
+
+    Args:
+        x: (m,) scores of one agent's runs; y: (n,) of the other's.
+    """
+    x, y = np.asarray(x, dtype=np.float64).ravel(), np.asarray(y, dtype=np.float64).ravel()
+    rng = np.random.default_rng(seed)
+    xs = x[rng.integers(0, x.size, size=(reps, x.size))].mean(axis=1)
+    ys = y[rng.integers(0, y.size, size=(reps, y.size))].mean(axis=1)
+    tail = 100.0 * (1.0 - confidence) / 2.0
+    low, high = np.percentile(xs - ys, [tail, 100.0 - tail])
+    return float(low), float(high)

@@ -112,7 +112,7 @@ def test_pages_refresh_their_generated_blocks_from_one_or_more_folders(tmp_path,
     assert main(["results", "--pages", "page.md"]) == 0 and '"changed": []' in capsys.readouterr().out
     page.write_text("<!-- roto results: pie a -->\n<!-- /roto results -->\n")
     assert main(["results", "--pages", "page.md"]) == 2
-    assert "unknown kind 'pie'; valid: ['baoding', 'bounce', 'overview']" in capsys.readouterr().err
+    assert "unknown kind 'pie'; valid: ['baoding', 'bounce', 'overview', 'touch']" in capsys.readouterr().err
 
 
 def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_path):
@@ -131,3 +131,13 @@ def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_p
 def test_pages_stand_alone(flags, capsys):
     assert main(["results", *flags]) == 2
     assert "refreshes the pages' generated tables; give it alone" in capsys.readouterr().err
+
+
+def test_touch_is_blind_minus_proprio_with_an_interval_from_three_seeds_each():
+    from roto.olympiad.reference_tables import touch_table
+
+    proprio = [summary("bounce", "shadow", "proprio", "ppo", s, {"bounces_mean": b}) for s, b in enumerate([5.0] * 3)]
+    lines = touch_table(SUMMARIES + proprio).splitlines()
+    assert lines[2] == "| bounce | shadow | 40.0 (4) | 5.0 (3) | +35.0 | " + lines[2].split(" | ")[-1]
+    assert lines[2].split(" | ")[-1].startswith("[") and len(lines) == 3  # the Allegro has no proprio agent
+    assert touch_table(SUMMARIES + proprio[:2]).splitlines()[2].endswith("| +35.0 | needs three seeds each |")

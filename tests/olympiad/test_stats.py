@@ -37,3 +37,11 @@ def test_probability_of_improvement_counts_pairs_and_half_ties():
     assert probability_of_improvement(y, x) == pytest.approx(0.5)
     assert probability_of_improvement(np.array([[5.0, 0.0]]), np.array([[1.0, 1.0]])) == 0.5  # tasks averaged
     assert probability_of_improvement(np.array([[3.0], [4.0]]), np.array([[1.0], [2.0]])) == 1.0
+
+
+def test_the_difference_interval_of_constant_groups_is_their_difference_and_widens_with_spread():
+    from roto.olympiad.stats import difference_ci
+
+    assert difference_ci([5.0, 5.0, 5.0], [2.0, 2.0]) == (3.0, 3.0)
+    low, high = difference_ci([4.0, 6.0, 5.0, 7.0], [1.0, 3.0, 2.0])
+    assert 1.0 <= low < 5.5 - 2.0 < high <= 6.0  # around the difference of means, within 4 - 3 and 7 - 1
