@@ -5,6 +5,7 @@ the task's lead measure (Baoding: round rotations; Bounce: bounces) as mean ± s
 95 % interval and per-seed values, roto's swap count beside Baoding's, the hand's reference and
 roto's published figures on the Shadow. ``overview_table``: the README's few lines, hands by
 (task, obs mode). ``touch_table``: blind minus proprio-only agents per (task, hand).
+``seeds_table``: Baoding's seeds one by one.
 ``refresh_blocks`` rewrites the generated blocks of a markdown page (between
 ``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] -->`` and ``<!-- /roto results -->``)
 from their folders.
@@ -185,11 +186,53 @@ def touch_table(summaries: list[dict]) -> str:
     return "\n".join(lines)
 
 
+FIRST = (1.0, 5.0)
+"""The lead measure's levels whose first evaluation round ``seeds_table`` names (Baoding: round rotations)."""
+
+
+def _first_reaching(evaluations: list[dict], key: str, level: float) -> str:
+    steps = next((r["env_steps"] for r in evaluations if r.get(key, float("-inf")) >= level), None)
+    return "never" if steps is None else f"{steps / 1e6:.2f} M"
+
+
+def seeds_table(summaries: list[dict]) -> str:
+    """Markdown: one row per seed (cell) of the tasks that lead with a measure of their own
+    (Baoding): its best policy's lead measure ± std over episodes, roto's count, the path metrics,
+    the env steps of the first training-time evaluation reaching each of ``FIRST``, and the
+    training time."""
+    lines = []
+    for task in [t for t in TASKS if get_task(t).selection_metric and any(s["task"] == t for s in summaries)]:
+        spec, lead = get_task(task), lead_measure(task)
+        paths = [name for name in spec.path_metric_names if name != lead]
+        head = ["cell", "seed", lead, f"roto's {spec.headline_metric}", *paths]
+        head += [f"first evaluation ≥ {level:g}" for level in FIRST] + ["env steps", "training"]
+        lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        rows = sorted(
+            (s for s in summaries if s["task"] == task),
+            key=lambda s: (_row_order((s["robot"], s["obs"], s["variant"])), s["seed"]),
+        )
+        for s in rows:
+            best = with_derived_means(task, s["best"])
+
+            def value(name: str, best: dict = best) -> str:
+                return f"{best[f'{name}_mean']:.2f}" if f"{name}_mean" in best else "not measured"
+
+            cells = [f"{s['robot']} / {s['obs']} / {s['variant']}", str(s["seed"])]
+            spread = f" ± {best[f'{lead}_std']:.2f}" if f"{lead}_std" in best else ""
+            cells += [f"**{value(lead)}**{spread}", value(spec.headline_metric), *(value(name) for name in paths)]
+            cells += [_first_reaching(s["evaluations"], f"{lead}_mean", level) for level in FIRST]
+            minutes = f"{s['train_wall_s'] / 60:.0f} min" if "train_wall_s" in s else ""
+            cells += [f"{s.get('env_steps', 0) / 1e6:.1f} M", minutes]
+            lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 TABLES: dict[str, Callable[[list[dict], Plan | None], str]] = {
     "bounce": lambda summaries, plan: task_table(summaries, "bounce", plan),
     "baoding": lambda summaries, plan: task_table(summaries, "baoding", plan),
     "overview": lambda summaries, plan: overview_table(summaries),
     "touch": lambda summaries, plan: touch_table(summaries),
+    "seeds": lambda summaries, plan: seeds_table(summaries),
 }
 """The kinds of generated block a page may hold, each a table of its source's summaries."""
 BLOCK = re.compile(r"(<!-- roto results: (\S+) (\S+)(?: plan=(\S+))? -->\n)(.*?)(<!-- /roto results -->)", re.DOTALL)

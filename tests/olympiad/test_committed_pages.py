@@ -46,11 +46,21 @@ def test_a_committed_page_is_what_its_summaries_generate(page):
     assert page.read_text() == results_markdown(summaries, plan), f"regenerate {page.parent}"
 
 
-@pytest.mark.parametrize("page", ["README.md", "docs/results.md"])
+GENERATED = sorted(
+    str(path.relative_to(ROOT))
+    for path in [ROOT / "README.md", *(ROOT / "docs").glob("*.md"), *(ROOT / "experiments").rglob("*.md")]
+    if "<!-- roto results: " in path.read_text()
+)
+
+
+@pytest.mark.parametrize("page", GENERATED)
 def test_the_generated_tables_of_a_page_are_what_their_summaries_generate(page):
     text = (ROOT / page).read_text()
-    assert "<!-- roto results: " in text
     assert refresh_blocks(text, ROOT) == text, f"run: roto results --pages {page}"
+
+
+def test_the_pages_with_generated_tables_are_found():
+    assert {"README.md", "docs/results.md", "experiments/baoding_turn_shaping/README.md"} <= set(GENERATED)
 
 
 def test_the_pages_are_found():

@@ -112,7 +112,7 @@ def test_pages_refresh_their_generated_blocks_from_one_or_more_folders(tmp_path,
     assert main(["results", "--pages", "page.md"]) == 0 and '"changed": []' in capsys.readouterr().out
     page.write_text("<!-- roto results: pie a -->\n<!-- /roto results -->\n")
     assert main(["results", "--pages", "page.md"]) == 2
-    assert "unknown kind 'pie'; valid: ['baoding', 'bounce', 'overview', 'touch']" in capsys.readouterr().err
+    assert "unknown kind 'pie'; valid: ['baoding', 'bounce', 'overview', 'seeds', 'touch']" in capsys.readouterr().err
 
 
 def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_path):
@@ -141,3 +141,21 @@ def test_touch_is_blind_minus_proprio_with_an_interval_from_three_seeds_each():
     assert lines[2] == "| bounce | shadow | 40.0 (4) | 5.0 (3) | +35.0 | " + lines[2].split(" | ")[-1]
     assert lines[2].split(" | ")[-1].startswith("[") and len(lines) == 3  # the Allegro has no proprio agent
     assert touch_table(SUMMARIES + proprio[:2]).splitlines()[2].endswith("| +35.0 | needs three seeds each |")
+
+
+def test_each_baoding_seed_gets_its_row_with_the_first_rounds_reaching_1_and_5():
+    from roto.olympiad.reference_tables import seeds_table
+
+    curve = [
+        {"env_steps": 1_000_000, "round_rotations_mean": 0.5},
+        {"env_steps": 2_000_000, "round_rotations_mean": 1.5},
+    ]
+    best = {"round_rotations_mean": 3.0, "round_rotations_std": 0.25, "rotations_mean": 4.0, "net_turns_mean": 3.5}
+    one = summary(
+        "baoding", "shadow", "blind", "turn", 7, best, evaluations=curve, env_steps=2_000_000, train_wall_s=600
+    )
+    lines = seeds_table([one, SUMMARIES[0]]).splitlines()  # Bounce has no row: it leads with its headline metric
+    assert lines[0].startswith("| cell | seed | round_rotations | roto's rotations | net_turns | travelled_turns |")
+    row = "| shadow / blind / turn | 7 | **3.00** ± 0.25 | 4.00 | 3.50 | not measured | 2.00 M | never | 2.0 M |"
+    assert lines[2] == row + " 10 min |"
+    assert len(lines) == 3
