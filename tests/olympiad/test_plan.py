@@ -255,7 +255,7 @@ def test_the_low_noise_variant_differs_from_all_three_only_in_the_policy_std():
 @pytest.mark.parametrize(
     ("plan_name", "robot", "variant"),
     [
-        ("baoding_v1_low_noise", "shadow", "task_critic_more_aids_low_noise"),
+        ("turn_shaping", "shadow", "recipe_turn20"),
         ("baoding_v1_cpu", "shadow_lite", "task_critic_more_aids"),
         ("baoding_v1_cpu", "allegro", "task_critic_more_aids"),
         ("baoding_v1_cpu", "orca", "task_critic_more_aids_low_noise"),
@@ -398,6 +398,7 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
     assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
         "env.aids.replayed_starts.bank": (round_bank, recipe.env.aids.replayed_starts.bank),
         "env.aids.round_swaps": ({"min_turn": 0.25}, None),
+        "env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None}),  # the recipe's since it ran
         "env.seed": (3, 0),
     }  # fmt: skip
     assert round_bank in packaged_banks()
