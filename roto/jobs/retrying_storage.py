@@ -17,6 +17,7 @@ and retried after the grace period. Neither loses a finished trial.
 from __future__ import annotations
 
 import abc
+import contextlib
 import sys
 import time
 from collections.abc import Callable
@@ -108,7 +109,8 @@ def connection_error(error: BaseException) -> BaseException | None:
     """The driver's connection error behind ``error`` (Optuna wraps it in StorageInternalError), or
     None when ``error`` is not about a lost or refused connection."""
     cause = error.__cause__ if isinstance(error, StorageInternalError) else error
-    if isinstance(cause, (sqlalchemy.exc.OperationalError, sqlalchemy.exc.InterfaceError)):
+    lost = (sqlalchemy.exc.OperationalError, sqlalchemy.exc.InterfaceError, sqlalchemy.exc.PendingRollbackError)
+    if isinstance(cause, lost):  # PendingRollbackError: a session whose transaction a lost connection broke
         return cause
     if isinstance(cause, sqlalchemy.exc.DBAPIError) and cause.connection_invalidated:
         return cause
@@ -165,8 +167,17 @@ class RetryingStorage(optuna.storages.BaseStorage):
                         flush=True,
                     )
                     announced = True
+                self.discard_session()
             self.sleep(pause)
             pause = min(2 * pause, MAX_PAUSE_S)
+
+    def discard_session(self) -> None:
+        """Drop this thread's database session (a database storage keeps one per thread): after a
+        lost connection it may hold a broken transaction that no later call could get past."""
+        sessions = getattr(self.inner, "scoped_session", None)
+        if sessions is not None:
+            with contextlib.suppress(sqlalchemy.exc.SQLAlchemyError):
+                sessions.remove()
 
     def __getattr__(self, name: str) -> Any:
         """Anything else the inner storage has (its engine, its URL), without retries."""

@@ -92,6 +92,37 @@ def test_a_lost_connection_is_retried_with_growing_pauses_until_it_answers(capsy
     assert capsys.readouterr().err.count("unreachable (server closed the connection unexpectedly)") == 1
 
 
+class Sessions:
+    """A database storage's per-thread sessions: counts how often the thread's session is dropped."""
+
+    def __init__(self) -> None:
+        self.removed = 0
+
+    def remove(self) -> None:
+        self.removed += 1
+
+
+def broken_session() -> StorageInternalError:
+    """What Optuna's database storage raises when a call reuses a session whose transaction a lost
+    connection broke (seen when the database restarted under a loaded two-worker sweep)."""
+    try:
+        raise sqlalchemy.exc.PendingRollbackError("Can't reconnect until invalid transaction is rolled back.")
+    except sqlalchemy.exc.PendingRollbackError as cause:
+        try:
+            raise StorageInternalError("An exception is raised during the commit.") from cause
+        except StorageInternalError as error:
+            return error
+
+
+def test_a_session_broken_by_a_lost_connection_is_dropped_and_the_call_retried(capsys):
+    inner = FlakyStorage(failures=2, error=broken_session())
+    inner.scoped_session = Sessions()
+    storage = RetryingStorage(inner, "postgresql://roto:***@db/roto", sleep=lambda s: None)
+    assert storage.get_trial(3) == "trial 3" and inner.calls == 3
+    assert inner.scoped_session.removed == 2  # before each retry: a fresh session, not the broken one
+    assert "unreachable (Can't reconnect until invalid transaction is rolled back.)" in capsys.readouterr().err
+
+
 def test_other_errors_are_raised_at_once():
     inner = FlakyStorage(failures=1, error=ValueError("bad value"))
     storage = RetryingStorage(
