@@ -238,8 +238,5 @@ def cmd_results(args: argparse.Namespace) -> int:
     plan_source = args.plan if source.is_dir() else args.source
     plan = load_plan(plan_source) if plan_source else None
     folder = source if source.is_dir() else pathlib.Path(args.root) / plan.name / "results"
-    result = write_results(
-        folder, args.out, plan=plan.name if plan else "", plan_read=plan, submissions=args.submissions
-    )
-    print(json.dumps(result))
+    print(json.dumps(write_results(folder, args.out, plan=plan, submissions=args.submissions)))
     return 0

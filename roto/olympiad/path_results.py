@@ -52,20 +52,34 @@ def path_metric_table(summaries: list[dict]) -> list[str]:
     return lines
 
 
-def lead_scores(summaries: Iterable[dict], policy: str = "best") -> tuple[dict[Key, np.ndarray], list[Key]]:
+def measure_scores(
+    summaries: Iterable[dict], task: str, measure: str, policy: str = "best"
+) -> dict[tuple[str, str, str], np.ndarray | None]:
+    """{(robot, obs, variant): (seeds,) ``measure`` of each seed's ``policy`` ("final" or "best") on
+    ``task``, seeds in order; None where some seed's summary neither holds nor can recompute it
+    (``with_derived_means``)."""
+    found: dict[tuple[str, str, str], list[tuple[int, float | None]]] = {}
+    for s in summaries:
+        if s["task"] == task:
+            value = with_derived_means(task, s[policy]).get(f"{measure}_mean")
+            found.setdefault((s["robot"], s["obs"], s["variant"]), []).append((s["seed"], value))
+    return {
+        row: None if any(v is None for _, v in runs) else np.array([v for _, v in sorted(runs)])
+        for row, runs in found.items()
+    }
+
+
+def lead_scores(summaries: list[dict], policy: str = "best") -> tuple[dict[Key, np.ndarray], list[Key]]:
     """The cells of tasks that lead with another measure than their headline metric
     (``Task.selection_metric``: Baoding's round rotations): ({cell: (seeds,) scores of that measure},
     [cells whose summaries, some seed's at least, did not measure it, nor can it be recomputed])."""
-    found: dict[Key, list[tuple[int, float | None]]] = {}
-    for s in summaries:
-        lead = get_task(s["task"]).selection_metric
-        if lead is None:
-            continue
-        value = with_derived_means(s["task"], s[policy]).get(f"{lead}_mean")
-        found.setdefault((s["task"], s["robot"], s["obs"], s["variant"]), []).append((s["seed"], value))
-    measured = {key: runs for key, runs in found.items() if all(v is not None for _, v in runs)}
-    scores = {key: np.array([v for _, v in sorted(runs)]) for key, runs in sorted(measured.items())}
-    return scores, sorted(set(found) - set(measured))
+    found: dict[Key, np.ndarray | None] = {}
+    for task in sorted({s["task"] for s in summaries}):
+        lead = get_task(task).selection_metric
+        if lead is not None:
+            found.update({(task, *row): v for row, v in measure_scores(summaries, task, lead, policy).items()})
+    scores = {key: v for key, v in sorted(found.items()) if v is not None}
+    return scores, sorted(key for key, v in found.items() if v is None)
 
 
 def lead_section(summaries: list[dict], agents: Agents, current: set[str]) -> list[str]:

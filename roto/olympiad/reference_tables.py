@@ -21,7 +21,7 @@ import numpy as np
 
 from roto.envs.observations import OBS_MODES
 from roto.olympiad.cell import cell_spec
-from roto.olympiad.path_results import with_derived_means
+from roto.olympiad.path_results import measure_scores, with_derived_means
 from roto.olympiad.plan import Cell, Plan, load_plan
 from roto.olympiad.results import cell_statistics, read_summaries
 from roto.olympiad.stats import difference_ci
@@ -46,20 +46,6 @@ def lead_measure(task: str) -> str:
     """The measure a task's results lead with: its selection metric, else its headline metric."""
     spec = get_task(task)
     return spec.selection_metric or spec.headline_metric
-
-
-def _scores(summaries: list[dict], task: str, measure: str) -> dict[Row, np.ndarray | None]:
-    """{(robot, obs, variant): (seeds,) ``measure`` of each seed's best policy, seeds in order;
-    None where a seed's summary neither holds nor can recompute it}."""
-    found: dict[Row, list[tuple[int, float | None]]] = {}
-    for s in summaries:
-        if s["task"] == task:
-            value = with_derived_means(task, s["best"]).get(f"{measure}_mean")
-            found.setdefault((s["robot"], s["obs"], s["variant"]), []).append((s["seed"], value))
-    return {
-        row: None if any(v is None for _, v in runs) else np.array([v for _, v in sorted(runs)])
-        for row, runs in found.items()
-    }
 
 
 def _row_order(row: Row) -> tuple[int, int, str]:
@@ -110,24 +96,23 @@ def task_table(summaries: list[dict], task: str, plan: Plan | None = None) -> st
     """Markdown: one row per (hand, obs mode, variant) of ``task`` in ``summaries`` (best policies,
     the evaluation episodes' mean per seed), each naming its config (``plan``: as that plan trains it)."""
     spec, lead = get_task(task), lead_measure(task)
-    scores = _scores(summaries, task, lead)
-    count = _scores(summaries, task, spec.headline_metric) if lead != spec.headline_metric else None
-    labels = {(s["robot"], s["obs"], s["variant"]): config_label(s, plan) for s in summaries if s["task"] == task}
-    seeds = {
-        row: sorted(s["seed"] for s in summaries if (s["task"], s["robot"], s["obs"], s["variant"]) == (task, *row))
-        for row in scores
-    }
-    aids = {}
-    for s in summaries:
-        if s["task"] == task:
-            aids.setdefault((s["robot"], s["obs"], s["variant"]), set()).add(training_aids(s, plan))
+    scores = measure_scores(summaries, task, lead)
+    count = measure_scores(summaries, task, spec.headline_metric) if lead != spec.headline_metric else None
+    labels: dict[Row, str] = {}
+    seeds: dict[Row, list[int]] = {}
+    aids: dict[Row, set[str]] = {}
+    for s in (s for s in summaries if s["task"] == task):
+        row = (s["robot"], s["obs"], s["variant"])
+        labels.setdefault(row, config_label(s, plan))
+        seeds.setdefault(row, []).append(s["seed"])
+        aids.setdefault(row, set()).add(training_aids(s, plan))
     head = ["hand", "obs", "agent config", "training aids", "seeds", f"{lead}: mean ± std", "IQM [95 % CI]", "per seed"]
     head += [f"roto's {spec.headline_metric}"] if count is not None else []
     head += [f"{spec.reference_name} ({spec.headline_metric})", "roto published (Shadow, 200 M)"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for row in sorted(scores, key=_row_order):
         robot, obs, _ = row
-        cells = [robot, obs, f"`{labels[row]}`", "; ".join(sorted(aids[row])), ", ".join(map(str, seeds[row]))]
+        cells = [robot, obs, f"`{labels[row]}`", "; ".join(sorted(aids[row])), ", ".join(map(str, sorted(seeds[row])))]
         cells += _statistics(scores[row])
         if count is not None:
             cells.append(_statistics(count[row])[0])
@@ -137,26 +122,31 @@ def task_table(summaries: list[dict], task: str, plan: Plan | None = None) -> st
     return "\n".join(lines)
 
 
+def lead_by_mode(summaries: list[dict]) -> dict[tuple[str, str, str], list[np.ndarray]]:
+    """{(task, robot, obs): each variant's (seeds,) lead measure (``lead_measure``) of its best
+    policies}, variants whose summaries did not measure it left out; in task and hand order."""
+    found: dict[tuple[str, str, str], list[np.ndarray]] = {}
+    for task in [t for t in TASKS if any(s["task"] == t for s in summaries)]:
+        scores = measure_scores(summaries, task, lead_measure(task))
+        for row in sorted(scores, key=_row_order):
+            if scores[row] is not None:
+                found.setdefault((task, row[0], row[1]), []).append(scores[row])
+    return found
+
+
 def overview_table(summaries: list[dict]) -> str:
     """Markdown for the README: hands as rows, (task, obs mode) as columns, each cell the task's lead
     measure (``lead_measure``: bounces, Baoding's round rotations) as the mean over seeds of the best
     policies, and the seed count."""
-    order = list(TASKS)
-    columns = sorted(
-        {(s["task"], s["obs"]) for s in summaries}, key=lambda c: (order.index(c[0]), list(OBS_MODES).index(c[1]))
-    )
-    robots = sorted({s["robot"] for s in summaries}, key=lambda r: _row_order((r, "blind", "")))
+    found = lead_by_mode(summaries)
+    order = {name: i for i, name in enumerate([*TASKS, *OBS_MODES])}
+    columns = sorted({(task, obs) for task, _, obs in found}, key=lambda c: (order[c[0]], order[c[1]]))
+    robots = sorted({robot for _, robot, _ in found}, key=lambda r: _row_order((r, "blind", "")))
     head = ["hand", *(f"{task} {obs}" for task, obs in columns)]  # the measures: each task's lead_measure
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for robot in robots:
-        cells = [robot]
-        for task, obs in columns:
-            rows = {
-                row: v for row, v in _scores(summaries, task, lead_measure(task)).items() if row[:2] == (robot, obs)
-            }
-            values = [v for v in rows.values() if v is not None]
-            cells.append(" / ".join(f"{v.mean():.1f} (n={v.size})" for v in values))
-        lines.append("| " + " | ".join(cells) + " |")
+        cells = [" / ".join(f"{v.mean():.1f} (n={v.size})" for v in found.get((t, robot, o), [])) for t, o in columns]
+        lines.append("| " + " | ".join([robot, *cells]) + " |")
     return "\n".join(lines)
 
 
@@ -164,25 +154,20 @@ def touch_table(summaries: list[dict]) -> str:
     """Markdown: touch's effect per (task, hand): the blind agents' lead measure minus the
     proprio-only agents' (best policies, mean over seeds; every variant of a mode pooled), with a
     95 % bootstrap interval of the difference once each side has three seeds or more."""
+    found = lead_by_mode(summaries)
     lines = [
         "| task | hand | blind (seeds) | proprio (seeds) | blind − proprio | 95 % CI |",
         "|---|---|---|---|---|---|",
     ]
-    for task in [t for t in TASKS if any(s["task"] == t for s in summaries)]:
-        scores = _scores(summaries, task, lead_measure(task))
-        for robot in sorted({row[0] for row in scores}, key=lambda r: _row_order((r, "blind", ""))):
-            sides = [
-                np.concatenate([v for row, v in scores.items() if row[:2] == (robot, obs) and v is not None] or [[]])
-                for obs in ("blind", "proprio")
-            ]
-            if not all(side.size for side in sides):
-                continue
-            blind, proprio = sides
-            interval = "needs three seeds each"
-            if min(blind.size, proprio.size) >= 3:
-                interval = "[{:.1f}, {:.1f}]".format(*difference_ci(blind, proprio))
-            cells = [task, robot, f"{blind.mean():.1f} ({blind.size})", f"{proprio.mean():.1f} ({proprio.size})"]
-            lines.append("| " + " | ".join([*cells, f"{blind.mean() - proprio.mean():+.1f}", interval]) + " |")
+    for task, robot, obs in found:
+        if obs != "blind" or (task, robot, "proprio") not in found:
+            continue
+        blind, proprio = (np.concatenate(found[(task, robot, mode)]) for mode in ("blind", "proprio"))
+        interval = "needs three seeds each"
+        if min(blind.size, proprio.size) >= 3:
+            interval = "[{:.1f}, {:.1f}]".format(*difference_ci(blind, proprio))
+        cells = [task, robot, f"{blind.mean():.1f} ({blind.size})", f"{proprio.mean():.1f} ({proprio.size})"]
+        lines.append("| " + " | ".join([*cells, f"{blind.mean() - proprio.mean():+.1f}", interval]) + " |")
     return "\n".join(lines)
 
 

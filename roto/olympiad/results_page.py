@@ -8,7 +8,7 @@ import pathlib
 from roto.cli_errors import check_output_path
 from roto.olympiad.manifest import write_manifest
 from roto.olympiad.path_results import lead_section, path_metric_table
-from roto.olympiad.plan import Plan, load_plan
+from roto.olympiad.plan import Plan
 from roto.olympiad.results import (
     current_tasks,
     improvements,
@@ -19,7 +19,7 @@ from roto.olympiad.results import (
     variant_agents,
     write_csv,
 )
-from roto.olympiad.submission_command import with_submissions
+from roto.olympiad.submission import with_submissions
 from roto.result_files import write_text_atomic
 
 
@@ -49,26 +49,21 @@ def results_markdown(summaries: list[dict], plan: str = "") -> str:
 
 
 def write_results(
-    source: str | pathlib.Path,
-    out: str | pathlib.Path,
-    plan: str = "",
-    submissions: str | None = None,
-    plan_read: Plan | None = None,
+    source: str | pathlib.Path, out: str | pathlib.Path, plan: Plan | None = None, submissions: str | None = None
 ) -> dict[str, str]:
-    """results.md, results_*.csv, manifest.csv and curve PNGs in ``out`` (``--out``: a folder, made with its missing
-    parents; refused, before anything is written, where it cannot be one) from the summaries in
-    ``source`` and, beside them, the submissions in the folder ``submissions``. ``plan``: the name
-    the pages give; ``plan_read``: the plan that names the manifest's configs (default: ``plan``
-    read by name)."""
+    """results.md, results_*.csv, manifest.csv and curve PNGs in ``out`` (``--out``: a folder, made
+    with its missing parents; refused, before anything is written, where it cannot be one) from the
+    summaries in ``source`` and, beside them, the submissions in the folder ``submissions``;
+    ``plan``, if given, names the pages and the manifest's configs."""
     summaries = read_summaries(source)
     if submissions is not None:
         summaries = with_submissions(summaries, submissions)
-    plan_read = plan_read or (load_plan(plan) if plan else None)
+    name = plan.name if plan else ""
     out = check_output_path(out, "--out", kind="dir")
     out.mkdir(parents=True, exist_ok=True)
-    write_manifest(summaries, out / "manifest.csv", plan_read)
+    write_manifest(summaries, out / "manifest.csv", plan)
     for policy in ("final", "best"):
         write_csv(scores_by_cell(summaries, policy), out / f"results_{policy}.csv", policy)
-    write_text_atomic(out / "results.md", results_markdown(summaries, plan))
-    plots = plot_curves(summaries, out, page_label(summaries, plan))
+    write_text_atomic(out / "results.md", results_markdown(summaries, name))
+    plots = plot_curves(summaries, out, page_label(summaries, name))
     return {"markdown": str(out / "results.md"), "plots": [str(p) for p in plots], "cells": len(summaries)}

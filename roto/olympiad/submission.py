@@ -214,3 +214,24 @@ def make_submission(
         ],
     }
     return check_submission("(being made)", data)
+
+
+def with_submissions(summaries: list[dict], folder: str | pathlib.Path) -> list[dict]:
+    """``summaries`` and the cell summaries of every submission in ``folder`` (``*.json``); refused
+    where a method's name is already a column of the same (task, hand, obs mode)."""
+    paths = sorted(pathlib.Path(folder).glob("*.json"))
+    if not paths:
+        raise FileNotFoundError(f"--submissions {str(folder)!r} holds no submission (*.json, docs/submissions.md)")
+    taken = {(s["task"], s["robot"], s["obs"], s["variant"]): s.get("plan") or "the baselines" for s in summaries}
+    out = list(summaries)
+    for path in paths:
+        rows = submission_summaries(read_submission(path), path.name)
+        cell = (rows[0]["task"], rows[0]["robot"], rows[0]["obs"], rows[0]["variant"])
+        if cell in taken:
+            raise ValueError(
+                f"submission {str(path)!r}: method {cell[3]!r} is already a column of {'/'.join(cell[:3])} "
+                f"({taken[cell]}); give the method another name"
+            )
+        taken[cell] = rows[0]["plan"]
+        out += rows
+    return out

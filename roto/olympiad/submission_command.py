@@ -1,11 +1,10 @@
-"""``roto submit`` (a submission from ``roto eval``'s files, one per training seed) and what
-``roto results`` does with submissions: ``--check FILE`` and ``--submissions FOLDER``."""
+"""``roto submit`` (a submission from ``roto eval``'s files, one per training seed) and ``roto
+results``' flags for submissions: ``--check FILE`` and ``--submissions FOLDER``."""
 
 from __future__ import annotations
 
 import argparse
 import json
-import pathlib
 import sys
 
 from roto.cli_errors import check_output_file, make_parents
@@ -78,26 +77,3 @@ def cmd_submit(args: argparse.Namespace) -> int:
     print(json.dumps({"submission": str(out), "method": args.method, "seeds": sorted(results)}))
     print(f"wrote {out}", file=sys.stderr)
     return 0
-
-
-def with_submissions(summaries: list[dict], folder: str | pathlib.Path) -> list[dict]:
-    """``summaries`` and the cell summaries of every submission in ``folder`` (``*.json``); refused
-    where a method's name is already a column of the same (task, hand, obs mode)."""
-    from roto.olympiad.submission import read_submission, submission_summaries
-
-    paths = sorted(pathlib.Path(folder).glob("*.json"))
-    if not paths:
-        raise FileNotFoundError(f"--submissions {str(folder)!r} holds no submission (*.json, docs/submissions.md)")
-    taken = {(s["task"], s["robot"], s["obs"], s["variant"]): s.get("plan") or "the baselines" for s in summaries}
-    out = list(summaries)
-    for path in paths:
-        rows = submission_summaries(read_submission(path), path.name)
-        cell = (rows[0]["task"], rows[0]["robot"], rows[0]["obs"], rows[0]["variant"])
-        if cell in taken:
-            raise ValueError(
-                f"submission {str(path)!r}: method {cell[3]!r} is already a column of {'/'.join(cell[:3])} "
-                f"({taken[cell]}); give the method another name"
-            )
-        taken[cell] = rows[0]["plan"]
-        out += rows
-    return out
