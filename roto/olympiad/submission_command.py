@@ -42,15 +42,16 @@ def cmd_check(path: str) -> int:
     return 0
 
 
-def evaluation_config(path: str, data: dict):
+def evaluation_config(path: str, data: object):
     """The env config a ``roto eval`` file names, with the training seed it evaluated."""
     from roto.envs.config import EnvConfig
     from roto.olympiad.results import json_kind
 
+    if not isinstance(data, dict):
+        raise ValueError(f"{path!r} holds {json_kind(data)}: not a file of roto eval")
     missing = [key for key in ("task", "robot", "obs", "touch", "train_seed", "per_episode") if key not in data]
-    if not isinstance(data, dict) or missing:
-        found = f"lacks {missing}" if isinstance(data, dict) else f"holds {json_kind(data)}"
-        raise ValueError(f"{path!r} {found}: not a file of roto eval (of this roto: run roto eval again)")
+    if missing:
+        raise ValueError(f"{path!r} lacks {missing}: not a file of roto eval (of this roto: run roto eval again)")
     touch = data["touch"] if data["obs"] != "proprio" else "binary"
     return EnvConfig(task=data["task"], robot=data["robot"], obs_mode=data["obs"], touch=touch), data["train_seed"]
 

@@ -152,6 +152,12 @@ def test_submit_refuses_files_of_different_cells_or_evaluation_seeds(tmp_path):
         _submit(files, args)
     with pytest.raises(ValueError, match="evaluates training seed 0 again"):
         _submit([files[0], files[0], files[1]], args)
+    (tmp_path / "number.json").write_text("7")
+    with pytest.raises(ValueError, match=r"holds an integer \(7\): not a file of roto eval"):
+        _submit([files[0], files[1], str(tmp_path / "number.json")], args)
+    (tmp_path / "other.json").write_text(json.dumps({"task": "baoding"}))
+    with pytest.raises(ValueError, match=r"lacks \['robot', 'obs', 'touch', 'train_seed', 'per_episode'\]"):
+        _submit([files[0], files[1], str(tmp_path / "other.json")], args)
     assert not (tmp_path / "s.json").exists()
 
 
