@@ -19,8 +19,8 @@ A plan is a YAML file::
     grids:                  # the cells: the union of these products
       - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0, 1]}
 
-The packaged plans are ``cpu`` and ``paper`` (``roto/configs/olympiad``). Everything a plan names
-is checked before anything runs.
+The packaged plans are ``benchmark``, ``paper`` and ``smoke`` (``roto/configs/olympiad``); one-off
+plans live in ``experiments/``. Everything a plan names is checked before anything runs.
 """
 
 from __future__ import annotations
