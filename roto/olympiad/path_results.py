@@ -4,6 +4,7 @@ summary written before they existed gets from its stored episodes."""
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Iterable
 
 import numpy as np
@@ -67,6 +68,24 @@ def measure_scores(
         row: None if any(v is None for _, v in runs) else np.array([v for _, v in sorted(runs)])
         for row, runs in found.items()
     }
+
+
+def seed_path_kind(task: str, summary: dict, policy: str = "best") -> str | None:
+    """What one seed's ``policy`` did with the balls (``Task.path_kind`` of its evaluation's means:
+    Baoding "round", "swing" or "no swaps"); None for a task without kinds or a summary that
+    cannot tell."""
+    means = with_derived_means(task, summary[policy])
+    return get_task(task).path_kind({k.removesuffix("_mean"): v for k, v in means.items() if k.endswith("_mean")})
+
+
+def kind_counts(kinds: Iterable[str | None]) -> str:
+    """The seeds' kinds counted, most frequent first ("round 4, swing 1"); "" when none has a kind,
+    "not measured" standing for a seed without one beside seeds with."""
+    names = ["not measured" if kind is None else kind for kind in kinds]
+    if all(name == "not measured" for name in names):
+        return ""
+    counts = Counter(names)
+    return ", ".join(f"{name} {n}" for name, n in sorted(counts.items(), key=lambda item: (-item[1], item[0])))
 
 
 def lead_scores(summaries: list[dict], policy: str = "best") -> tuple[dict[Key, np.ndarray], list[Key]]:

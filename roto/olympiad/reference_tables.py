@@ -21,7 +21,7 @@ import numpy as np
 
 from roto.envs.observations import OBS_MODES
 from roto.olympiad.cell import cell_spec
-from roto.olympiad.path_results import measure_scores, with_derived_means
+from roto.olympiad.path_results import kind_counts, measure_scores, seed_path_kind, with_derived_means
 from roto.olympiad.plan import Cell, Plan, load_plan
 from roto.olympiad.results import cell_statistics, read_summaries
 from roto.olympiad.stats import difference_ci
@@ -101,12 +101,16 @@ def task_table(summaries: list[dict], task: str, plan: Plan | None = None) -> st
     labels: dict[Row, str] = {}
     seeds: dict[Row, list[int]] = {}
     aids: dict[Row, set[str]] = {}
+    kinds: dict[Row, list[str | None]] = {}
     for s in (s for s in summaries if s["task"] == task):
         row = (s["robot"], s["obs"], s["variant"])
         labels.setdefault(row, config_label(s, plan))
         seeds.setdefault(row, []).append(s["seed"])
         aids.setdefault(row, set()).add(training_aids(s, plan))
+        kinds.setdefault(row, []).append(seed_path_kind(task, s))
+    with_kinds = any(kind_counts(k) for k in kinds.values())
     head = ["hand", "obs", "agent config", "training aids", "seeds", f"{lead}: mean ± std", "IQM [95 % CI]", "per seed"]
+    head += ["seeds by path"] if with_kinds else []
     head += [f"roto's {spec.headline_metric}"] if count is not None else []
     head += [f"{spec.reference_name} ({spec.headline_metric})", "roto published (Shadow, 200 M)"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -114,6 +118,7 @@ def task_table(summaries: list[dict], task: str, plan: Plan | None = None) -> st
         robot, obs, _ = row
         cells = [robot, obs, f"`{labels[row]}`", "; ".join(sorted(aids[row])), ", ".join(map(str, sorted(seeds[row])))]
         cells += _statistics(scores[row])
+        cells += [kind_counts(kinds[row])] if with_kinds else []
         if count is not None:
             cells.append(_statistics(count[row])[0])
         cells.append(f"{spec.reference[robot]}" if robot in spec.reference else "")
@@ -189,7 +194,7 @@ def seeds_table(summaries: list[dict]) -> str:
     for task in [t for t in TASKS if get_task(t).selection_metric and any(s["task"] == t for s in summaries)]:
         spec, lead = get_task(task), lead_measure(task)
         paths = [name for name in spec.path_metric_names if name != lead]
-        head = ["cell", "seed", lead, f"roto's {spec.headline_metric}", *paths]
+        head = ["cell", "seed", lead, f"roto's {spec.headline_metric}", *paths, "path"]
         head += [f"first evaluation ≥ {level:g}" for level in FIRST] + ["env steps", "training"]
         lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         rows = sorted(
@@ -205,6 +210,7 @@ def seeds_table(summaries: list[dict]) -> str:
             cells = [f"{s['robot']} / {s['obs']} / {s['variant']}", str(s["seed"])]
             spread = f" ± {best[f'{lead}_std']:.2f}" if f"{lead}_std" in best else ""
             cells += [f"**{value(lead)}**{spread}", value(spec.headline_metric), *(value(name) for name in paths)]
+            cells.append(seed_path_kind(task, s) or "not measured")
             cells += [_first_reaching(s["evaluations"], f"{lead}_mean", level) for level in FIRST]
             minutes = f"{s['train_wall_s'] / 60:.0f} min" if "train_wall_s" in s else ""
             cells += [f"{s.get('env_steps', 0) / 1e6:.1f} M", minutes]

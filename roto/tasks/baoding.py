@@ -39,6 +39,9 @@ UNBOUNDED_LEAD = 1e9
 DENSE_SCALE = 0.1
 DENSE_LENGTH = 0.1
 """Dense reward 0.1 · Σ (1 − tanh(d / 0.1)) per step."""
+ROUND_SHARE = 0.8
+"""A policy goes round when its mean net turns are at least this share of its mean rotations by
+roto's count (``path_kind``); a swing out and back makes about 0.25 net turns however often it swaps."""
 MAX_SEPARATION = 0.15
 """Balls this far apart end the episode (m)."""
 RESET_NOISE = 0.005
@@ -305,3 +308,13 @@ class Baoding:
         if "rotations" not in episode or "net_turns" not in episode:
             return {}
         return {"round_rotations": min(episode["rotations"], episode["net_turns"])}
+
+    def path_kind(self, means: Mapping[str, float]) -> str | None:
+        """The kind of a policy's paths: "no swaps" below one rotation per episode; else "round" when
+        the mean net turns are at least ``ROUND_SHARE`` of the mean rotations (roto's count),
+        "swing" when not; None without both means."""
+        if "rotations" not in means or "net_turns" not in means:
+            return None
+        if means["rotations"] < 1.0:
+            return "no swaps"
+        return "round" if means["net_turns"] >= ROUND_SHARE * means["rotations"] else "swing"

@@ -143,6 +143,13 @@ class Task(Protocol):
         Empty where the given measures do not include what one needs."""
         ...
 
+    def path_kind(self, means: Mapping[str, float]) -> str | None:
+        """What a policy did with the balls, from the means over its evaluation episodes of the
+        task's metrics and path metrics (``means``: {measure: mean}): a name results tables count
+        seeds by (Baoding: "round", "swing" or "no swaps"); None for a task without such kinds
+        or where ``means`` lacks what the kind needs."""
+        ...
+
 
 def uniform(
     generator: torch.Generator, shape: tuple[int, ...], half_width: float, device: torch.device

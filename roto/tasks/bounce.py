@@ -149,3 +149,7 @@ class Bounce:
     def derived_metrics(self, episode: Mapping[str, float]) -> dict[str, float]:
         """None (no path metrics)."""
         return {}
+
+    def path_kind(self, means: Mapping[str, float]) -> str | None:
+        """None: a bounce has no kinds."""
+        return None

@@ -6,7 +6,7 @@ import pytest
 from roto.cli import main
 from roto.olympiad.manifest import manifest_rows
 from roto.olympiad.plan import load_plan
-from roto.olympiad.reference_tables import overview_table, refresh_blocks, task_table
+from roto.olympiad.reference_tables import overview_table, refresh_blocks, seeds_table, task_table
 
 
 def summary(task, robot, obs, variant, seed, best, **extra):
@@ -156,6 +156,34 @@ def test_each_baoding_seed_gets_its_row_with_the_first_rounds_reaching_1_and_5()
     )
     lines = seeds_table([one, SUMMARIES[0]]).splitlines()  # Bounce has no row: it leads with its headline metric
     assert lines[0].startswith("| cell | seed | round_rotations | roto's rotations | net_turns | travelled_turns |")
-    row = "| shadow / blind / turn | 7 | **3.00** ± 0.25 | 4.00 | 3.50 | not measured | 2.00 M | never | 2.0 M |"
+    row = (
+        "| shadow / blind / turn | 7 | **3.00** ± 0.25 | 4.00 | 3.50 | not measured | round | 2.00 M | never | 2.0 M |"
+    )
     assert lines[2] == row + " 10 min |"
     assert len(lines) == 3
+
+
+def baoding_seed(seed, rotations, net_turns):
+    best = {"rotations_mean": rotations, "net_turns_mean": net_turns, "round_rotations_mean": min(rotations, net_turns)}
+    return summary("baoding", "allegro", "blind", "mix", seed, best)
+
+
+def test_baoding_tables_count_the_seeds_that_go_round_swing_or_never_swap():
+    # seed 0 goes round (net turns 0.9 of its rotations), 1 swings (0.25 net turns), 2 makes half a
+    # rotation per episode, 3 is exactly at 0.8 of its rotations
+    seeds = [
+        baoding_seed(0, 10.0, 9.0),
+        baoding_seed(1, 12.0, 0.25),
+        baoding_seed(2, 0.5, 0.5),
+        baoding_seed(3, 5.0, 4.0),
+    ]
+    table = task_table(seeds, "baoding")
+    assert "| per seed | seeds by path | roto's rotations |" in table.splitlines()[0]
+    assert rows_of(table)[("allegro", "blind")][8] == "round 2, no swaps 1, swing 1"
+    kinds = [line.split(" | ")[6] for line in seeds_table(seeds).splitlines()[2:]]
+    assert kinds == ["round", "swing", "no swaps", "round"]
+    older = summary("baoding", "allegro", "blind", "mix", 4, {"rotations_mean": 3.0})  # no net turns measured
+    assert rows_of(task_table([*seeds, older], "baoding"))[("allegro", "blind")][8] == (
+        "round 2, no swaps 1, not measured 1, swing 1"
+    )
+    assert "seeds by path" not in task_table([older], "baoding") and "by path" not in task_table(SUMMARIES, "bounce")

@@ -74,6 +74,9 @@ class Hold:
     def derived_metrics(self, episode: Mapping[str, float]) -> dict[str, float]:
         return {}
 
+    def path_kind(self, means: Mapping[str, float]) -> str | None:
+        return None
+
 
 @pytest.fixture
 def hold_task(monkeypatch):

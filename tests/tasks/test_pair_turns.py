@@ -74,3 +74,14 @@ def test_baodings_derived_metrics_need_both_rotations_and_net_turns():
     assert task.derived_metrics({"rotations": 1.0, "net_turns": 1.4}) == {"round_rotations": 1.0}
     assert task.derived_metrics({"rotations": 3.0}) == {}
     assert get_task("bounce").derived_metrics({"bounces": 60.0}) == {}
+
+
+def test_baodings_path_kind_tells_a_round_policy_from_a_swing_and_one_that_never_swaps():
+    from roto.tasks import get_task
+
+    task = get_task("baoding")
+    assert task.path_kind({"rotations": 10.0, "net_turns": 8.0}) == "round"  # exactly 0.8 of its rotations
+    assert task.path_kind({"rotations": 10.0, "net_turns": 7.9}) == "swing"
+    assert task.path_kind({"rotations": 13.3, "net_turns": 0.26}) == "swing"
+    assert task.path_kind({"rotations": 0.9, "net_turns": 0.0}) == "no swaps"
+    assert task.path_kind({"rotations": 3.0}) is None and get_task("bounce").path_kind({"bounces": 60.0}) is None
