@@ -4,7 +4,8 @@
 the task's lead measure (Baoding: round rotations; Bounce: bounces) as mean ± std, IQM with its
 95 % interval and per-seed values, roto's swap count beside Baoding's, the hand's reference and
 roto's published figures on the Shadow. ``overview_table``: the README's few lines, hands by
-(task, obs mode). ``touch_table``: blind minus proprio-only agents per (task, hand).
+(task, obs mode). ``orderings_table``: per (task, hand) the gaps state − blind and touch's effect (blind − proprio)
+with their intervals, and whether state ≥ blind ≥ proprio holds.
 ``seeds_table``: Baoding's seeds one by one.
 ``refresh_blocks`` rewrites the generated blocks of a markdown page (between
 ``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] -->`` and ``<!-- /roto results -->``)
@@ -155,24 +156,44 @@ def overview_table(summaries: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def touch_table(summaries: list[dict]) -> str:
-    """Markdown: touch's effect per (task, hand): the blind agents' lead measure minus the
-    proprio-only agents' (best policies, mean over seeds; every variant of a mode pooled), with a
-    95 % bootstrap interval of the difference once each side has three seeds or more."""
+def _pooled(found: dict[tuple[str, str, str], list[np.ndarray]], task: str, robot: str, obs: str) -> np.ndarray | None:
+    """Every seed of every variant of one (task, hand, obs mode), or None where it has none."""
+    return np.concatenate(found[(task, robot, obs)]) if (task, robot, obs) in found else None
+
+
+def _gap(x: np.ndarray, y: np.ndarray) -> tuple[str, str]:
+    """(mean(x) − mean(y), its 95 % bootstrap interval once each side has three seeds or more)."""
+    interval = "needs three seeds each"
+    if min(x.size, y.size) >= 3:
+        interval = "[{:.1f}, {:.1f}]".format(*difference_ci(x, y))
+    return f"{x.mean() - y.mean():+.1f}", interval
+
+
+ORDER = ("state", "blind", "proprio")
+"""The paper's ordering of the obs modes on every task and hand: seeing the balls' state beats touch,
+touch beats proprioception alone."""
+
+
+def orderings_table(summaries: list[dict]) -> str:
+    """Markdown: per (task, hand) with all three obs modes, their lead measure (best policies, mean
+    over seeds, variants pooled), the gaps state − blind and blind − proprio with 95 % bootstrap
+    intervals, and whether the means keep the paper's order (``ORDER``) or which pair breaks it."""
     found = lead_by_mode(summaries)
     lines = [
-        "| task | hand | blind (seeds) | proprio (seeds) | blind − proprio | 95 % CI |",
-        "|---|---|---|---|---|---|",
+        "| task | hand | state (seeds) | blind (seeds) | proprio (seeds) | state − blind | 95 % CI "
+        "| blind − proprio | 95 % CI | state ≥ blind ≥ proprio |",
+        "|" + "---|" * 10,
     ]
-    for task, robot, obs in found:
-        if obs != "blind" or (task, robot, "proprio") not in found:
+    keys = {(task, robot) for task, robot, _ in found}
+    for task, robot in sorted(keys, key=lambda k: (list(TASKS).index(k[0]), _row_order((k[1], "blind", "")))):
+        modes = [_pooled(found, task, robot, obs) for obs in ORDER]
+        if any(m is None for m in modes):
             continue
-        blind, proprio = (np.concatenate(found[(task, robot, mode)]) for mode in ("blind", "proprio"))
-        interval = "needs three seeds each"
-        if min(blind.size, proprio.size) >= 3:
-            interval = "[{:.1f}, {:.1f}]".format(*difference_ci(blind, proprio))
-        cells = [task, robot, f"{blind.mean():.1f} ({blind.size})", f"{proprio.mean():.1f} ({proprio.size})"]
-        lines.append("| " + " | ".join([*cells, f"{blind.mean() - proprio.mean():+.1f}", interval]) + " |")
+        means = [m.mean() for m in modes]
+        broken = [f"{ORDER[i]} < {ORDER[i + 1]}" for i in range(len(ORDER) - 1) if means[i] < means[i + 1]]
+        cells = [task, robot, *(f"{m.mean():.1f} ({m.size})" for m in modes)]
+        cells += [*_gap(modes[0], modes[1]), *_gap(modes[1], modes[2]), "; ".join(broken) or "holds"]
+        lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -222,7 +243,7 @@ TABLES: dict[str, Callable[[list[dict], Plan | None], str]] = {
     "bounce": lambda summaries, plan: task_table(summaries, "bounce", plan),
     "baoding": lambda summaries, plan: task_table(summaries, "baoding", plan),
     "overview": lambda summaries, plan: overview_table(summaries),
-    "touch": lambda summaries, plan: touch_table(summaries),
+    "orderings": lambda summaries, plan: orderings_table(summaries),
     "seeds": lambda summaries, plan: seeds_table(summaries),
 }
 """The kinds of generated block a page may hold, each a table of its source's summaries."""

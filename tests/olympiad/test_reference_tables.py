@@ -112,7 +112,9 @@ def test_pages_refresh_their_generated_blocks_from_one_or_more_folders(tmp_path,
     assert main(["results", "--pages", "page.md"]) == 0 and '"changed": []' in capsys.readouterr().out
     page.write_text("<!-- roto results: pie a -->\n<!-- /roto results -->\n")
     assert main(["results", "--pages", "page.md"]) == 2
-    assert "unknown kind 'pie'; valid: ['baoding', 'bounce', 'overview', 'seeds', 'touch']" in capsys.readouterr().err
+    assert (
+        "unknown kind 'pie'; valid: ['baoding', 'bounce', 'orderings', 'overview', 'seeds']" in capsys.readouterr().err
+    )
 
 
 def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_path):
@@ -133,14 +135,28 @@ def test_pages_stand_alone(flags, capsys):
     assert "refreshes the pages' generated tables; give it alone" in capsys.readouterr().err
 
 
-def test_touch_is_blind_minus_proprio_with_an_interval_from_three_seeds_each():
-    from roto.olympiad.reference_tables import touch_table
+def test_orderings_give_both_gaps_with_intervals_and_name_the_pair_that_breaks_the_papers_order():
+    from roto.olympiad.reference_tables import orderings_table
 
-    proprio = [summary("bounce", "shadow", "proprio", "ppo", s, {"bounces_mean": b}) for s, b in enumerate([5.0] * 3)]
-    lines = touch_table(SUMMARIES + proprio).splitlines()
-    assert lines[2] == "| bounce | shadow | 40.0 (4) | 5.0 (3) | +35.0 | " + lines[2].split(" | ")[-1]
-    assert lines[2].split(" | ")[-1].startswith("[") and len(lines) == 3  # the Allegro has no proprio agent
-    assert touch_table(SUMMARIES + proprio[:2]).splitlines()[2].endswith("| +35.0 | needs three seeds each |")
+    def mode(obs, values, robot="shadow"):
+        return [summary("bounce", robot, obs, "ppo", s, {"bounces_mean": b}) for s, b in enumerate(values)]
+
+    proprio = mode("proprio", [5.0] * 3)
+    state = mode("state", [50.0, 60.0, 70.0])
+    lines = orderings_table(SUMMARIES + proprio + state).splitlines()
+    assert len(lines) == 3  # the Allegro has no blind or proprio agent: no row
+    cells = [cell.strip() for cell in lines[2].strip("|").split(" | ")]
+    assert cells[:5] == ["bounce", "shadow", "60.0 (3)", "40.0 (4)", "5.0 (3)"]
+    assert cells[5] == "+20.0" and cells[6].startswith("[") and cells[7] == "+35.0" and cells[8].startswith("[")
+    assert cells[9] == "holds"
+    low_state = mode("state", [1.0, 2.0])  # two seeds: no interval; state below blind breaks the order
+    cells = [
+        cell.strip()
+        for cell in orderings_table(SUMMARIES + proprio + low_state).splitlines()[2].strip("|").split(" | ")
+    ]
+    assert cells[5:7] == ["-38.5", "needs three seeds each"] and cells[9] == "state < blind"
+    both = orderings_table(mode("state", [1.0]) + mode("blind", [2.0]) + mode("proprio", [3.0]))
+    assert both.splitlines()[2].endswith("| state < blind; blind < proprio |")
 
 
 def test_each_baoding_seed_gets_its_row_with_the_first_rounds_reaching_1_and_5():
