@@ -6,6 +6,8 @@ balls lying where they fell, and how often the hand drops them.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
+
 import torch
 
 from roto.envs.episodes import first_episodes
@@ -52,3 +54,27 @@ def run_hold(
     }
     stats.update({f"mean_{name}": float(result[name].mean()) for name in env.task.metric_names})
     return stats
+
+
+def tolerated_noise(
+    rows: Iterable[Mapping[str, object]], robot: str, share: float = 0.5, episode_steps: int = 600
+) -> float:
+    """The largest action noise under which ``robot``'s hold pose keeps the Baoding balls for at
+    least ``share`` of an ``episode_steps`` episode on average: a property of the hand that bounds
+    how much exploration noise its policy can start with before it mostly drops the balls.
+
+    Args:
+        rows: ``run_hold`` results (``benchmarks/baoding_hold.py --noise ...``: one per hand and
+            noise level, with ``robot``, ``action_noise`` and ``mean_length``).
+        robot: the hand.
+    Raises ValueError when no row of ``robot`` keeps the balls that long (naming the noise levels
+    measured).
+    """
+    mine = sorted((float(r["action_noise"]), float(r["mean_length"])) for r in rows if r["robot"] == robot)
+    kept = [noise for noise, length in mine if length >= share * episode_steps]
+    if not kept:
+        raise ValueError(
+            f"no measured noise level keeps {robot!r}'s balls for {share:g} of an episode; "
+            f"measured (noise, mean length): {mine}"
+        )
+    return max(kept)
