@@ -80,8 +80,8 @@ def summary_path(results: pathlib.Path, cell: Cell) -> pathlib.Path:
 
 
 def cell_spec(plan: Plan, cell: Cell) -> RunSpec:
-    """What a cell trains: the plan's envs and budget, the variant's agent and env overrides for the
-    task, the cell's seed (which wins over any ``env.seed`` override)."""
+    """What a cell trains: the plan's envs, the cell's budget (``Plan.steps_for``), the variant's
+    agent and env overrides for the task, the cell's seed (which wins over any ``env.seed`` override)."""
     agent_cfg, overrides = plan.variants[cell.variant].agent_for(cell.task, cell.robot)
     spec = build_run_spec(
         cell.task,
@@ -89,7 +89,7 @@ def cell_spec(plan: Plan, cell: Cell) -> RunSpec:
         cell.obs,
         agent_cfg,
         overrides,
-        plan.steps,
+        plan.steps_for(cell),
         num_envs=plan.num_envs,
         threads=plan.threads,
         backend=plan.backend,

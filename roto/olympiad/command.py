@@ -166,11 +166,13 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
 
     status = cell_status(plan, root, results, storage)
     tasks = {cell.name: get_task(cell.task) for cell in plan.cells}
-    lines = [f"plan {plan.name}: {len(plan.cells)} cells, {plan.steps} env steps each", ""]
+    budgets = {cell.name: plan.steps_for(cell) for cell in plan.cells}
+    each = f"{plan.steps} env steps each" if len(set(budgets.values())) == 1 else "env steps per cell as listed"
+    lines = [f"plan {plan.name}: {len(plan.cells)} cells, {each}", ""]
     done_steps, running_rates, started_rates = {}, [], []
     for name, state in status.items():
         records = [] if state == "done" else read_evaluations(pathlib.Path(root) / plan.name / name)
-        done_steps[name] = min(int(records[-1]["env_steps"]), plan.steps) if records else 0
+        done_steps[name] = min(int(records[-1]["env_steps"]), budgets[name]) if records else 0
         rate_now = recent_rate(records)
         if rate_now:
             started_rates.append(rate_now)
@@ -178,9 +180,10 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
                 running_rates.append(rate_now)
         so_far = headline_so_far(records, *status_metrics(tasks[name], records))
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps{so_far})" if records else ""
-        lines.append(f"  {name:<52} {state}{progress}")
+        budget = f" [{budgets[name] / 1e6:g} M]" if len(set(budgets.values())) > 1 else ""
+        lines.append(f"  {name:<52} {state}{budget}{progress}")
     left = sum(state != "done" for state in status.values())
-    cells_left = [plan.steps - done_steps[name] for name, state in status.items() if state != "done"]
+    cells_left = [budgets[name] - done_steps[name] for name, state in status.items() if state != "done"]
     try:
         summaries = read_summaries(results)
     except FileNotFoundError:

@@ -18,6 +18,8 @@ A plan is a YAML file::
         bounce: {agent_cfg: "{recipe}"}
     grids:                  # the cells: the union of these products
       - {tasks: [bounce], robots: [shadow, allegro], obs: [blind], variants: [ppo], seeds: [0, 1]}
+      - {tasks: [baoding], robots: [allegro], obs: [blind], variants: [ppo], seeds: [0], steps: 20000000}
+                            # a grid's own steps: its cells' budget instead of the plan's
 
 The packaged plans are ``benchmark``, ``paper`` and ``smoke`` (``roto/configs/olympiad``); one-off
 plans live in ``experiments/``. Everything a plan names is checked before anything runs.
@@ -28,7 +30,8 @@ from __future__ import annotations
 import importlib.resources
 import itertools
 import pathlib
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 from roto.envs.observations import OBS_MODES
@@ -48,6 +51,7 @@ ROTO_AGENTS = ("ppo", "forward_dynamics", "forward_dynamics_memory")
 stands beside that agent's roto v1 figure in ``roto results``; a variant that declares none (a
 privileged critic, a swept config, another touch) stands beside none."""
 GRID_KEYS = {"tasks", "robots", "obs", "variants", "seeds"}
+"""A grid's lists, each required; a grid may also name its cells' ``steps``."""
 ROBOT_FIELD = "{robot}"
 """Written in a variant's override or agent config, replaced by each cell's robot name."""
 RECIPE_FIELD = "{recipe}"
@@ -131,6 +135,12 @@ class Plan:
     backend: str = "cpu"
     device: str = "cpu"
     description: str = ""
+    budgets: Mapping[str, int] = field(default_factory=dict)
+    """{cell name: env steps} of the cells whose grid names its own ``steps``."""
+
+    def steps_for(self, cell: Cell) -> int:
+        """The env steps ``cell`` trains: its grid's ``steps``, else the plan's."""
+        return self.budgets.get(cell.name, self.steps)
 
 
 def packaged_plans() -> dict[str, pathlib.Path]:
@@ -159,11 +169,17 @@ def load_plan(plan: str) -> Plan:
         name: _variant(name, spec, f"{where}: variant {name!r}") for name, spec in (data.get("variants") or {}).items()
     }
     # in the plan's order, seed-major: every cell gets its first seed before any gets a second
-    listed = [
-        cell
-        for i, grid in enumerate(data.get("grids") or [])
-        for cell in _grid_cells(grid, variants, f"{where}: grids[{i}]")
-    ]
+    listed, budgets = [], {}
+    for i, grid in enumerate(data.get("grids") or []):
+        grid_cells, steps = _grid_cells(grid, variants, f"{where}: grids[{i}]")
+        for cell in grid_cells:
+            budget = numbers["steps"] if steps is None else steps
+            if budgets.setdefault(cell.name, budget) != budget:
+                raise ValueError(
+                    f"{where}: grids[{i}] gives cell {cell.name} {budget} env steps, "
+                    f"an earlier grid {budgets[cell.name]}; give each cell one budget"
+                )
+        listed += grid_cells
     cells = sorted(dict.fromkeys(listed), key=lambda cell: cell.seed)
     if not cells:
         raise ValueError(f"{where} has no cells: give at least one grid with tasks, robots, obs, variants, seeds")
@@ -177,6 +193,7 @@ def load_plan(plan: str) -> Plan:
         backend=backend,
         device=device,
         description=str(data.get("description", "")),
+        budgets={name: steps for name, steps in budgets.items() if steps != numbers["steps"]},
         **numbers,
     )
 
@@ -204,8 +221,12 @@ def _variant(name: str, spec: Any, where: str) -> Variant:
     return Variant(name, tuple(per_task))
 
 
-def _grid_cells(grid: Any, variants: dict[str, Variant], where: str) -> list[Cell]:
-    _check_keys(grid, GRID_KEYS, where)
+def _grid_cells(grid: Any, variants: dict[str, Variant], where: str) -> tuple[list[Cell], int | None]:
+    """The grid's cells and its own ``steps`` (None: the plan's)."""
+    _check_keys(grid, GRID_KEYS | {"steps"}, where)
+    steps = grid.get("steps")
+    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, int) or steps < 1):
+        raise ValueError(f"{where}: steps must be an integer >= 1, got {steps!r}")
     valid = {"tasks": sorted(TASKS), "robots": sorted(ROBOTS), "obs": list(OBS_MODES), "variants": sorted(variants)}
     for key in GRID_KEYS:
         values = grid.get(key)
@@ -225,7 +246,5 @@ def _grid_cells(grid: Any, variants: dict[str, Variant], where: str) -> list[Cel
             resolve_groups(spec.agent, obs)
         except (ValueError, FileNotFoundError) as error:
             raise ValueError(f"{where}: variant {name!r} on {task}/{robot}/{obs}: {error}") from None
-    return [
-        Cell(*values)
-        for values in itertools.product(grid["tasks"], grid["robots"], grid["obs"], grid["variants"], grid["seeds"])
-    ]
+    values = itertools.product(grid["tasks"], grid["robots"], grid["obs"], grid["variants"], grid["seeds"])
+    return [Cell(*v) for v in values], steps
