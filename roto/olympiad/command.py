@@ -167,7 +167,8 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
     status = cell_status(plan, root, results, storage)
     tasks = {cell.name: get_task(cell.task) for cell in plan.cells}
     budgets = {cell.name: plan.steps_for(cell) for cell in plan.cells}
-    each = f"{plan.steps} env steps each" if len(set(budgets.values())) == 1 else "env steps per cell as listed"
+    uniform = len(set(budgets.values())) == 1
+    each = f"{plan.steps} env steps each" if uniform else "env steps per cell as listed"
     lines = [f"plan {plan.name}: {len(plan.cells)} cells, {each}", ""]
     done_steps, running_rates, started_rates = {}, [], []
     for name, state in status.items():
@@ -180,7 +181,7 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
                 running_rates.append(rate_now)
         so_far = headline_so_far(records, *status_metrics(tasks[name], records))
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps{so_far})" if records else ""
-        budget = f" [{budgets[name] / 1e6:g} M]" if len(set(budgets.values())) > 1 else ""
+        budget = "" if uniform else f" [{budgets[name] / 1e6:g} M]"
         lines.append(f"  {name:<52} {state}{budget}{progress}")
     left = sum(state != "done" for state in status.values())
     cells_left = [budgets[name] - done_steps[name] for name, state in status.items() if state != "done"]

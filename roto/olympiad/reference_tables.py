@@ -4,8 +4,8 @@
 the task's lead measure (Baoding: round rotations; Bounce: bounces) as mean ± std, IQM with its
 95 % interval and per-seed values, roto's swap count beside Baoding's, the hand's reference and
 roto's published figures on the Shadow. ``overview_table``: the README's few lines, hands by
-(task, obs mode). ``orderings_table``: per (task, hand) the gaps state − blind and touch's effect (blind − proprio)
-with their intervals, and whether state ≥ blind ≥ proprio holds.
+(task, obs mode). ``orderings_table``: per (task, hand) the gaps state − blind and touch's effect
+(blind − proprio) with their intervals, and whether state ≥ blind ≥ proprio holds.
 ``seeds_table``: Baoding's seeds one by one.
 ``refresh_blocks`` rewrites the generated blocks of a markdown page (between
 ``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] -->`` and ``<!-- /roto results -->``)
@@ -109,7 +109,8 @@ def task_table(summaries: list[dict], task: str, plan: Plan | None = None) -> st
         seeds.setdefault(row, []).append(s["seed"])
         aids.setdefault(row, set()).add(training_aids(s, plan))
         kinds.setdefault(row, []).append(seed_path_kind(task, s))
-    with_kinds = any(kind_counts(k) for k in kinds.values())
+    counts = {row: kind_counts(k) for row, k in kinds.items()}
+    with_kinds = any(counts.values())
     head = ["hand", "obs", "agent config", "training aids", "seeds", f"{lead}: mean ± std", "IQM [95 % CI]", "per seed"]
     head += ["seeds by path"] if with_kinds else []
     head += [f"roto's {spec.headline_metric}"] if count is not None else []
@@ -119,7 +120,7 @@ def task_table(summaries: list[dict], task: str, plan: Plan | None = None) -> st
         robot, obs, _ = row
         cells = [robot, obs, f"`{labels[row]}`", "; ".join(sorted(aids[row])), ", ".join(map(str, sorted(seeds[row])))]
         cells += _statistics(scores[row])
-        cells += [kind_counts(kinds[row])] if with_kinds else []
+        cells += [counts[row]] if with_kinds else []
         if count is not None:
             cells.append(_statistics(count[row])[0])
         cells.append(f"{spec.reference[robot]}" if robot in spec.reference else "")
@@ -184,14 +185,13 @@ def orderings_table(summaries: list[dict]) -> str:
         "| blind − proprio | 95 % CI | state ≥ blind ≥ proprio |",
         "|" + "---|" * 10,
     ]
-    keys = {(task, robot) for task, robot, _ in found}
-    for task, robot in sorted(keys, key=lambda k: (list(TASKS).index(k[0]), _row_order((k[1], "blind", "")))):
+    for task, robot in dict.fromkeys((task, robot) for task, robot, _ in found):  # lead_by_mode's order
         modes = [_pooled(found, task, robot, obs) for obs in ORDER]
         if any(m is None for m in modes):
             continue
         means = [m.mean() for m in modes]
         broken = [f"{ORDER[i]} < {ORDER[i + 1]}" for i in range(len(ORDER) - 1) if means[i] < means[i + 1]]
-        cells = [task, robot, *(f"{m.mean():.1f} ({m.size})" for m in modes)]
+        cells = [task, robot, *(f"{mean:.1f} ({m.size})" for mean, m in zip(means, modes, strict=True))]
         cells += [*_gap(modes[0], modes[1]), *_gap(modes[1], modes[2]), "; ".join(broken) or "holds"]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
