@@ -101,6 +101,10 @@ class PPOConfig:
     cuda_graph: bool = False
     """Replay each minibatch step from a CUDA graph (roto/rl/graphed_step.py): the same update with
     far fewer kernel launches. CUDA devices only, without auxiliary losses."""
+    cuda_graph_rollout: bool = False
+    """Replay the rollout's policy pass (observation normalisation, actor and critic, the action
+    drawn from noise drawn just before it, its log-probability) from a CUDA graph
+    (roto/rl/graphed_call.py): the same actions, one launch per env step. CUDA devices only."""
     fused_adam: bool = False
     """Step Adam with PyTorch's fused implementation (a few kernels for all parameters instead of
     several per parameter): the same update up to rounding, fewer launches on a GPU."""

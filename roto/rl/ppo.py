@@ -17,6 +17,7 @@ from torch import nn
 
 from roto.rl.config import PPOConfig
 from roto.rl.gae import compute_gae
+from roto.rl.graphed_call import GraphedCall
 from roto.rl.graphed_step import GraphedMinibatchStep
 from roto.rl.losses import kl_adaptive_lr, ppo_terms, weighted_sum
 from roto.rl.networks import ActorCritic, Obs
@@ -98,6 +99,14 @@ class PPO:
         self.value_scaler = None
         if config.value_normalization:
             self.value_scaler = RunningStandardScaler(1, clip=None).to(storage.values.device)
+        self._graphed_sample: GraphedCall | None = None
+        if config.cuda_graph_rollout:
+            device = storage.values.device
+            if device.type != "cuda":
+                raise ValueError(
+                    f"ppo.cuda_graph_rollout=true needs the envs on a CUDA device, got device={str(device)!r}"
+                )
+            self._graphed_sample = GraphedCall(self._sample)
         self._step: dict[str, Any] = {}
 
     # -------------------------------------------------------------- values in return units
@@ -118,12 +127,25 @@ class PPO:
     @torch.no_grad()
     def act(self, obs: Obs) -> torch.Tensor:
         """Sample actions (B, n) for observations ``obs``; remember them for ``process_step``."""
-        mean, log_std, value, _ = self.model(obs)
+        first = next(iter(obs.values()))
+        shape = (first.shape[0], self.model.num_actions)
+        noise = torch.randn(shape, generator=self.generator, device=first.device)
+        if self._graphed_sample is None:
+            drawn = self._sample({"obs": obs, "noise": noise})
+        else:  # the recorded outputs are overwritten by the next step: the env gets its own action
+            drawn = dict(self._graphed_sample({"obs": obs, "noise": noise}))
+            drawn["action"] = drawn["action"].clone()
+        self._step = {"obs": obs, **drawn}
+        return drawn["action"]
+
+    def _sample(self, inputs: dict[str, Any]) -> dict[str, torch.Tensor]:
+        """The policy's action for observations ``inputs["obs"]`` and standard-normal ``inputs["noise"]``
+        (B, n): {"action" (B, n), "log_prob" (B,), "value" (B,) in return units}."""
+        mean, log_std, value, _ = self.model(inputs["obs"])
         std = log_std.exp().expand_as(mean)
-        action = mean + std * torch.randn(mean.shape, generator=self.generator, device=mean.device)
+        action = mean + std * inputs["noise"]
         log_prob = torch.distributions.Normal(mean, std, validate_args=False).log_prob(action).sum(-1)
-        self._step = {"obs": obs, "action": action, "log_prob": log_prob, "value": self.values(value)}
-        return action
+        return {"action": action, "log_prob": log_prob, "value": self.values(value)}
 
     @torch.no_grad()
     def process_step(

@@ -203,3 +203,52 @@ def test_bf16_update_moves_the_weights_as_the_fp32_update_does():
     cosine = torch.nn.functional.cosine_similarity(step_fp32, step_bf16, dim=0)
     assert cosine > 0.99  # 0.9989 when written
     assert not torch.allclose(step_fp32, step_bf16, rtol=1e-4, atol=1e-7)
+
+
+def test_a_graphed_rollout_off_a_gpu_is_refused_naming_it():
+    message = r"ppo\.cuda_graph_rollout=true needs the envs on a CUDA device, got device='cpu'"
+    with pytest.raises(ValueError, match=message):
+        learner(torch.device("cpu"), ["ppo.cuda_graph_rollout=true"])
+
+
+def test_an_action_is_the_policy_mean_plus_its_std_times_the_generators_next_normal_draw():
+    """The rollout's draw (eager here, the same function graphed on a GPU): noise from the learner's
+    generator, drawn before the policy pass, so a run's actions are what they were before."""
+    alg = learner(torch.device("cpu"), [])
+    obs = {g: torch.randn(NUM_ENVS, d) for g, d in SIZES.items()}
+    expected_noise = torch.randn((NUM_ENVS, NUM_ACTIONS), generator=alg.generator.clone_state())
+    action = alg.act(obs)
+    with torch.no_grad():
+        mean, log_std, _, _ = alg.model(obs)
+    torch.testing.assert_close(action, mean + log_std.exp() * expected_noise)
+    assert alg._step["log_prob"].shape == (NUM_ENVS,) and alg._step["value"].shape == (NUM_ENVS,)
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_graphed_rollouts_act_and_train_as_eager_ones():
+    """The same generator draws, the same actions, log-probabilities and values, step after step and
+    after updates change the weights and statistics the graph reads in place; no host sync."""
+    device = torch.device("cuda")
+    eager, graphed = learner(device, []), learner(device, ["ppo.cuda_graph_rollout=true"])
+    for seed in range(3):
+        data = torch.Generator(device="cpu").manual_seed(seed)
+        for step in range(eager.storage.steps):
+            obs = {g: torch.randn(NUM_ENVS, d, generator=data).to(device) for g, d in SIZES.items()}
+            if seed or step:  # the first call captures (allocations are allowed there)
+                torch.cuda.set_sync_debug_mode("error")
+            try:
+                graphed_action = graphed.act(obs)
+            finally:
+                torch.cuda.set_sync_debug_mode(0)
+            torch.testing.assert_close(graphed_action, eager.act(obs), rtol=1e-5, atol=1e-6)
+            for key in ("log_prob", "value"):
+                torch.testing.assert_close(graphed._step[key], eager._step[key], rtol=1e-5, atol=1e-5)
+            reward = torch.randn(NUM_ENVS, generator=data).to(device)
+            done = (torch.rand(NUM_ENVS, generator=data) < 0.1).to(device)
+            for alg in (eager, graphed):
+                alg.process_step(reward, done, torch.zeros_like(done), {})
+        last = {g: torch.randn(NUM_ENVS, d, generator=data).to(device) for g, d in SIZES.items()}
+        for alg in (eager, graphed):
+            alg.compute_returns(last)
+            alg.update()
