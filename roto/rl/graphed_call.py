@@ -17,24 +17,48 @@ running statistics) are read where they are, so in-place updates to them reach e
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import torch
 
-from roto.rl.graphed_step import WARMUP_STEPS, clone_tree, copy_tree
+WARMUP_STEPS = 3
+"""Eager steps on a side stream before the capture (PyTorch's guidance for whole-network capture)."""
 
-Tensors = dict[str, torch.Tensor]
+Metrics = dict[str, torch.Tensor]
+"""What a graphed function returns: named tensors."""
+
+
+def copy_tree(target: Any, source: Any) -> None:
+    """Copy a nested dict of tensors into one of the same structure and shapes, in place."""
+    if isinstance(target, dict):
+        if target.keys() != source.keys():
+            raise ValueError(f"a graphed step's inputs changed keys: {sorted(target)} -> {sorted(source)}")
+        for key, value in target.items():
+            copy_tree(value, source[key])
+        return
+    if target.shape != source.shape:
+        raise ValueError(f"a graphed step's inputs changed shape: {tuple(target.shape)} -> {tuple(source.shape)}")
+    target.copy_(source)
+
+
+def clone_tree(source: Any) -> Any:
+    """A copy of a nested dict of tensors, with storage of its own."""
+    if isinstance(source, dict):
+        return {key: clone_tree(value) for key, value in source.items()}
+    return source.detach().clone()
 
 
 class GraphedCall:
-    """``fn(inputs) -> outputs``, replayed from a CUDA graph (no autograd)."""
+    """``fn(inputs) -> outputs``, replayed from a CUDA graph. This class captures without autograd;
+    ``roto.rl.graphed_step.GraphedMinibatchStep`` captures a training step (backward included)."""
 
-    def __init__(self, fn: Callable[[dict], Tensors]) -> None:
+    def __init__(self, fn: Callable[[dict], Metrics]) -> None:
         self._fn = fn
         self._graph: torch.cuda.CUDAGraph | None = None
         self._inputs: dict = {}
-        self._outputs: Tensors = {}
+        self._outputs: Metrics = {}
 
-    def __call__(self, inputs: dict) -> Tensors:
+    def __call__(self, inputs: dict) -> Metrics:
         """``fn``'s outputs for ``inputs`` (valid until the next call)."""
         if self._graph is None:
             self._capture(inputs)
@@ -46,12 +70,20 @@ class GraphedCall:
     def _capture(self, inputs: dict) -> None:
         """Warm up on a side stream, then record one call."""
         self._inputs = clone_tree(inputs)
+        self._warm_up()
+        self._record()
+
+    def _warm_up(self) -> None:
+        """``WARMUP_STEPS`` calls on the recorded inputs, on a side stream (CUDA loads its kernels)."""
         side = torch.cuda.Stream()
         side.wait_stream(torch.cuda.current_stream())
         with torch.cuda.stream(side):
             for _ in range(WARMUP_STEPS):
                 self._fn(self._inputs)
         torch.cuda.current_stream().wait_stream(side)
+
+    def _record(self) -> None:
+        """One call on the recorded inputs, captured: its outputs become the recorded outputs."""
         graph = torch.cuda.CUDAGraph()
         with torch.cuda.graph(graph):
             self._outputs = self._fn(self._inputs)

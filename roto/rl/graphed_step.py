@@ -21,35 +21,11 @@ step without auxiliary losses is such a step (``roto.rl.ppo``; ``ppo.cuda_graph`
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import torch
 from torch import nn
 
-WARMUP_STEPS = 3
-"""Eager steps on a side stream before the capture (PyTorch's guidance for whole-network capture)."""
-
-Metrics = dict[str, torch.Tensor]
-
-
-def copy_tree(target: Any, source: Any) -> None:
-    """Copy a nested dict of tensors into one of the same structure and shapes, in place."""
-    if isinstance(target, dict):
-        if target.keys() != source.keys():
-            raise ValueError(f"a graphed step's inputs changed keys: {sorted(target)} -> {sorted(source)}")
-        for key, value in target.items():
-            copy_tree(value, source[key])
-        return
-    if target.shape != source.shape:
-        raise ValueError(f"a graphed step's inputs changed shape: {tuple(target.shape)} -> {tuple(source.shape)}")
-    target.copy_(source)
-
-
-def clone_tree(source: Any) -> Any:
-    """A copy of a nested dict of tensors, with storage of its own."""
-    if isinstance(source, dict):
-        return {key: clone_tree(value) for key, value in source.items()}
-    return source.detach().clone()
+from roto.rl.graphed_call import GraphedCall, Metrics, clone_tree
 
 
 def _optimizer_tensors(optimizer: torch.optim.Optimizer) -> list[torch.Tensor]:
@@ -57,7 +33,7 @@ def _optimizer_tensors(optimizer: torch.optim.Optimizer) -> list[torch.Tensor]:
     return [value for state in optimizer.state.values() for value in state.values() if torch.is_tensor(value)]
 
 
-class GraphedMinibatchStep:
+class GraphedMinibatchStep(GraphedCall):
     """``step(batch) -> metrics``, replayed from a CUDA graph.
 
     Args:
@@ -69,18 +45,8 @@ class GraphedMinibatchStep:
     """
 
     def __init__(self, step: Callable[[dict], Metrics], model: nn.Module, optimizer: torch.optim.Optimizer) -> None:
-        self._step, self._model, self._optimizer = step, model, optimizer
-        self._graph: torch.cuda.CUDAGraph | None = None
-        self._inputs: dict = {}
-        self._outputs: Metrics = {}
-
-    def __call__(self, batch: dict) -> Metrics:
-        """Train on ``batch``; the step's metrics (valid until the next call)."""
-        if self._graph is None:
-            self._capture(batch)
-        copy_tree(self._inputs, batch)
-        self._graph.replay()
-        return self._outputs
+        super().__init__(step)
+        self._model, self._optimizer = model, optimizer
 
     def _capture(self, batch: dict) -> None:
         """Warm up on a side stream, undo the warm-up, record one step."""
@@ -89,12 +55,7 @@ class GraphedMinibatchStep:
         saved_params = [p.clone() for p in params]
         had_state = bool(self._optimizer.state)
         saved_state = [t.clone() for t in _optimizer_tensors(self._optimizer)]
-        side = torch.cuda.Stream()
-        side.wait_stream(torch.cuda.current_stream())
-        with torch.cuda.stream(side):
-            for _ in range(WARMUP_STEPS):
-                self._step(self._inputs)
-        torch.cuda.current_stream().wait_stream(side)
+        self._warm_up()
         with torch.no_grad():
             for param, saved in zip(params, saved_params, strict=True):
                 param.copy_(saved)
@@ -106,7 +67,4 @@ class GraphedMinibatchStep:
                 for tensor in state:
                     tensor.zero_()
         self._optimizer.zero_grad(set_to_none=True)  # backward allocates the gradients inside the graph
-        graph = torch.cuda.CUDAGraph()
-        with torch.cuda.graph(graph):
-            self._outputs = self._step(self._inputs)
-        self._graph = graph
+        self._record()

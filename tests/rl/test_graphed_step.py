@@ -9,7 +9,7 @@ import torch
 
 from roto.rl.build import build_learner, build_model
 from roto.rl.config import load_agent_config
-from roto.rl.graphed_step import clone_tree, copy_tree
+from roto.rl.graphed_call import clone_tree, copy_tree
 
 SIZES = {"proprio": 12, "tactile": 4}
 NUM_ACTIONS = 3
