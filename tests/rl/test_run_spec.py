@@ -24,7 +24,7 @@ def test_env_overrides_set_any_env_field_and_win_over_flags():
 def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_wins(tmp_path):
     base, banks = tmp_path / "aided.yaml", pathlib.Path(SHADOW_BANK).parent  # the reference controller's banks
     base.write_text(
-        "extends: baoding_cpu\ntraining_aids:\n"
+        "extends: baoding_cpu_v1\ntraining_aids:\n"
         f"  replayed_starts: {{bank: '{banks}/{{robot}}_preswap.npz', share: 0.25}}\n"
         "  tolerance: {start: 0.025}\n"
     )
@@ -36,18 +36,18 @@ def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_
     assert (replayed.bank, replayed.share) == (f"{banks}/allegro_preswap.npz", 0.5)  # through extends
     assert (
         spec.env.aids.tolerance.start == 0.02 and spec.agent.ppo.epochs == 4
-    )  # the override wins; baoding_cpu's agent
+    )  # the override wins; baoding_cpu_v1's agent
     assert spec.env.aids.round_swaps.min_turn == 0.25  # switched on by an override, at its default
     off = build_run_spec("baoding", "allegro", "blind", str(tmp_path / "more.yaml"), ["env.aids.tolerance=null"])
     assert off.env.aids.tolerance is None and off.env.aids.replayed_starts == replayed
-    assert spec.env.without_training_aids() == build_run_spec("baoding", "allegro", "blind", "baoding_cpu").env
-    base.write_text("extends: baoding_cpu\ntraining_aids:\n  num_envs: 4096\n")
+    assert spec.env.without_training_aids() == build_run_spec("baoding", "allegro", "blind", "baoding_cpu_v1").env
+    base.write_text("extends: baoding_cpu_v1\ntraining_aids:\n  num_envs: 4096\n")
     with pytest.raises(ValueError, match=r"unknown training aid aids.num_envs; valid aids: \['replayed_starts'"):
         build_run_spec("baoding", "allegro", "blind", str(base))
-    base.write_text("extends: baoding_cpu\ntraining_aids: [replayed_starts]\n")
+    base.write_text("extends: baoding_cpu_v1\ntraining_aids: [replayed_starts]\n")
     with pytest.raises(ValueError, match=r"training_aids must be a mapping of aids to their settings, got \[.replayed"):
         build_run_spec("baoding", "allegro", "blind", str(base))
-    base.write_text("extends: baoding_cpu\ntraining_aids:\n  replay_share: 0.5\n")  # the flat form of format 1
+    base.write_text("extends: baoding_cpu_v1\ntraining_aids:\n  replay_share: 0.5\n")  # the flat form of format 1
     with pytest.raises(ValueError, match=r"\['replay_share'\] are now set per aid, as \['replayed_starts.share'\]"):
         build_run_spec("baoding", "allegro", "blind", str(base))
     with pytest.raises(ValueError, match=r"env.replay_share=0.5.*set per aid now: env.aids.replayed_starts.share="):

@@ -18,7 +18,7 @@ def toy_hand():
     shadow = ROBOTS["shadow"]
     bounce = dataclasses.replace(shadow.tasks["bounce"], reference=3.0, recipe="bounce_cpu_orca")
     baoding = PairRecord(
-        reference=1.5, warp_peaks=(12, 65), recipe="baoding_cpu", geometry=shadow.tasks["baoding"].geometry
+        reference=1.5, warp_peaks=(12, 65), recipe="baoding_cpu_v1", geometry=shadow.tasks["baoding"].geometry
     )
     tasks = MappingProxyType({"bounce": bounce, "baoding": baoding})
     return dataclasses.replace(shadow, name="toy", display_name="Toy", tasks=tasks)

@@ -27,7 +27,7 @@ def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load
     noise = load_space("cpu_quickstart_noise", orca, "bounce_cpu_quickstart")
     assert noise.parameters[:7] == quick.parameters and noise.parameters[7].key == "network.init_log_std"
     bank = "shadow_preswap"
-    baoding = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu",
+    baoding = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu_v1",
                          [f"env.aids.replayed_starts.bank={bank}", "env.aids.replayed_starts.share=0.25"])  # fmt: skip
     assert [p.key for p in baoding.parameters] == [
         *(p.key for p in plain.parameters), "network.max_log_std", "env.aids.replayed_starts.share"
@@ -35,9 +35,10 @@ def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load
     with pytest.raises(
         ValueError, match=r"aids.replayed_starts needs \['bank'\], got \{'share': 0\.1\}"
     ):  # the bank is the study's to set
-        load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu")
-    recipe = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu_shadow")  # its own bank
-    assert [p.key for p in recipe.parameters] == [p.key for p in baoding.parameters]
+        load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu_v1")
+    for recipe_cfg in ("baoding_cpu", "baoding_cpu_shadow"):  # each with its own bank
+        recipe = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), recipe_cfg)
+        assert [p.key for p in recipe.parameters] == [p.key for p in baoding.parameters]
 
 
 def test_ssl_parameters_expand_over_the_base_configs_auxiliary_losses():
