@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
     """Register ``roto olympiad`` and ``roto results``."""
     p = sub.add_parser("olympiad", help="train and evaluate a plan of hands x tasks x obs modes x agents x seeds")
-    p.add_argument("plan", help="a packaged plan (cpu, paper) or a plan YAML file")
+    p.add_argument("plan", help="a packaged plan (benchmark, paper, smoke) or a plan YAML file")
     p.add_argument("--root", default="runs/olympiad", help="where run directories go (<root>/<plan>/<cell>)")
     p.add_argument("--results", default=None, help="folder of the cells' summaries (default <root>/<plan>/results)")
     p.add_argument("--storage", default=None, help=STORAGE_HELP)

@@ -33,7 +33,10 @@ from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import checkpoint_path
 
 CELL_ATTR = "cell"
-LIVE = (TrialState.COMPLETE, TrialState.RUNNING, TrialState.WAITING)
+LIVE = (TrialState.RUNNING, TrialState.WAITING)
+"""A cell's trial in these states keeps it: nothing else is enqueued for it. A cell whose trial
+finished but whose summary is gone (taken away to continue its run to a longer budget) is enqueued
+again; its run directory continues where it stopped."""
 
 
 def study_name(plan: Plan) -> str:
@@ -66,10 +69,11 @@ def enqueue_missing(study: optuna.Study, plan: Plan, results: pathlib.Path) -> l
     return missing
 
 
-def is_duplicate(study: optuna.Study, number: int, cell: str) -> bool:
-    """Whether a lower-numbered trial of ``cell`` runs or has finished (that one keeps the cell)."""
-    others = cell_trials(study, (TrialState.COMPLETE, TrialState.RUNNING)).get(cell, [])
-    return any(t.number < number or t.state == TrialState.COMPLETE for t in others)
+def is_duplicate(study: optuna.Study, number: int, cell: str, done: bool) -> bool:
+    """Whether ``cell`` is another trial's: it has its summary (``done``), or a lower-numbered trial
+    of it runs."""
+    running = cell_trials(study, (TrialState.RUNNING,)).get(cell, [])
+    return done or any(t.number < number for t in running)
 
 
 def claim_next(
@@ -140,7 +144,7 @@ def run_olympiad_worker(
         if name not in cells:
             tell_failed(study, trial, f"unknown cell {name!r}: not in plan {plan.name!r}")
             continue
-        if is_duplicate(study, trial.number, name):
+        if is_duplicate(study, trial.number, name, summary_path(results, cells[name]).is_file()):
             tell_failed(study, trial, f"duplicate: another trial has cell {name}")
             continue
         run_dir = root_dir / name
@@ -162,9 +166,9 @@ def cell_status(plan: Plan, root: str, results: pathlib.Path, storage_url: str |
         ("failed", (TrialState.FAIL,)),
         ("waiting", (TrialState.WAITING,)),
         ("running", (TrialState.RUNNING,)),
-        ("done", (TrialState.COMPLETE,)),
     )
-    for label, states in by_state:  # later labels win: a cell failed once and now running is running
+    # later labels win: a cell failed once and now running is running; done is its summary's to say
+    for label, states in by_state:
         for name in cell_trials(study, states):
             if name in status and status[name] != "done":
                 status[name] = label

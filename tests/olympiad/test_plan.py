@@ -445,3 +445,34 @@ def test_the_benchmark_plan_trains_every_hand_and_mode_with_its_record_s_recipe_
     }
     shared = [c for c in plan.cells if c in set(cpu.cells)]  # the cpu plan's Bounce cells, same names
     assert len(shared) == 24 and all(cell_spec(plan, c).differences(cell_spec(cpu, c)) == {} for c in shared)
+
+
+def test_baoding_cpu_is_what_the_every_hand_and_small_net_studies_trained():
+    """The packaged one-for-every-hand recipe is, on each hand, the Shadow's recipe with the hand's
+    own bank and the smaller encoder: what the every-hand pilot trained on its seed-0 cells (as
+    overrides of baoding_cpu_shadow) and the small-net study on the Shadow, so their results are
+    baoding_cpu's."""
+    from roto.olympiad.cell import cell_spec
+    from roto.rl.run_spec import build_run_spec
+
+    small = ["network.encoder=[512, 256, 128]"]
+    for robot in ROBOTS:
+        recipe = build_run_spec("baoding", robot, "blind", "baoding_cpu", [], 10_000_000, num_envs=128, threads=1)
+        pilot = [f"env.aids.replayed_starts.bank={robot}_preswap", *small]
+        as_trained = build_run_spec(
+            "baoding", robot, "blind", "baoding_cpu_shadow", pilot, 10_000_000, num_envs=128, threads=1
+        )
+        assert recipe.differences(as_trained) == {}
+        assert recipe.env.aids.replayed_starts.bank == f"{robot}_preswap"
+    study = plan_named("every_hand")
+    for cell in study.cells:
+        recipe = build_run_spec(
+            "baoding", cell.robot, "blind", "baoding_cpu", [], 1, num_envs=128, threads=1, seed=cell.seed
+        )
+        assert cell_spec(study, cell).differences(recipe) == {}
+    small_net = plan_named("small_net")
+    for cell in small_net.cells:
+        recipe = build_run_spec(
+            "baoding", "shadow", "blind", "baoding_cpu", [], 1, num_envs=128, threads=1, seed=cell.seed
+        )
+        assert cell_spec(small_net, cell).differences(recipe) == {}

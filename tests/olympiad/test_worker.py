@@ -133,6 +133,26 @@ def test_started_cells_are_claimed_before_fresh_cells_the_most_trained_first_wit
         assert steps == sorted(set(steps)) and steps[-1] == 8 * 4 * 6  # continued, not restarted
 
 
+def test_a_finished_cell_whose_summary_is_taken_away_continues_to_the_plans_longer_budget(tmp_path):
+    """The way to give finished cells more env steps: a longer budget in the plan, their summaries
+    moved aside; their runs continue where they stopped, and cells that keep a summary stay done."""
+    root = tmp_path / "runs"
+    plan = load_plan(str(write_toy_plan(tmp_path, updates=2, seeds=(0,))))
+    assert toy_worker(tmp_path / "toy.yaml", root) == len(plan.cells)
+    results, longer = root / plan.name / "results", plan.cells[0]
+    (results / f"{longer.name}.json").unlink()
+    plan = load_plan(str(write_toy_plan(tmp_path, updates=4, seeds=(0,))))
+    assert cell_status(plan, str(root), results, None)[longer.name] == "not started"
+
+    assert toy_worker(tmp_path / "toy.yaml", root) == 1
+    steps = [r["env_steps"] for r in read_evaluations(root / plan.name / longer.name)]
+    assert steps == sorted(set(steps)) and steps[-1] == 8 * 4 * 4  # continued from 2 updates, not restarted
+    assert json.loads((results / f"{longer.name}.json").read_text())["env_steps"] == 8 * 4 * 4
+    for cell in plan.cells[1:]:
+        assert json.loads((results / f"{cell.name}.json").read_text())["env_steps"] == 8 * 4 * 2
+    assert set(cell_status(plan, str(root), results, None).values()) == {"done"}
+
+
 def test_a_waiting_cell_no_longer_in_the_plan_is_failed_with_its_name(tmp_path):
     plan_path = write_toy_plan(tmp_path, seeds=(0,))
     plan, root = load_plan(str(plan_path)), tmp_path / "runs"
