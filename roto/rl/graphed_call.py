@@ -32,12 +32,12 @@ def copy_tree(target: Any, source: Any) -> None:
     """Copy a nested dict of tensors into one of the same structure and shapes, in place."""
     if isinstance(target, dict):
         if target.keys() != source.keys():
-            raise ValueError(f"a graphed step's inputs changed keys: {sorted(target)} -> {sorted(source)}")
+            raise ValueError(f"a graphed call's inputs changed keys: {sorted(target)} -> {sorted(source)}")
         for key, value in target.items():
             copy_tree(value, source[key])
         return
     if target.shape != source.shape:
-        raise ValueError(f"a graphed step's inputs changed shape: {tuple(target.shape)} -> {tuple(source.shape)}")
+        raise ValueError(f"a graphed call's inputs changed shape: {tuple(target.shape)} -> {tuple(source.shape)}")
     target.copy_(source)
 
 

@@ -46,9 +46,13 @@ def check_graphable(config: PPOConfig, storage: RolloutBuffer, aux_losses: list[
             f"ppo.cuda_graph=true needs minibatches of one size: ppo.rollouts x num_envs = {samples} "
             f"is not divisible by ppo.minibatches={config.minibatches}"
         )
-    device = storage.values.device
+    require_cuda("ppo.cuda_graph", storage.values.device)
+
+
+def require_cuda(setting: str, device: torch.device) -> None:
+    """Raise ValueError naming ``setting`` unless the envs (and so the learner) are on a CUDA device."""
     if device.type != "cuda":
-        raise ValueError(f"ppo.cuda_graph=true needs the envs on a CUDA device, got device={str(device)!r}")
+        raise ValueError(f"{setting}=true needs the envs on a CUDA device, got device={str(device)!r}")
 
 
 @contextlib.contextmanager
@@ -101,11 +105,7 @@ class PPO:
             self.value_scaler = RunningStandardScaler(1, clip=None).to(storage.values.device)
         self._graphed_sample: GraphedCall | None = None
         if config.cuda_graph_rollout:
-            device = storage.values.device
-            if device.type != "cuda":
-                raise ValueError(
-                    f"ppo.cuda_graph_rollout=true needs the envs on a CUDA device, got device={str(device)!r}"
-                )
+            require_cuda("ppo.cuda_graph_rollout", storage.values.device)
             self._graphed_sample = GraphedCall(self._sample)
         self._step: dict[str, Any] = {}
 
