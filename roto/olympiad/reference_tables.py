@@ -6,10 +6,11 @@ the task's lead measure (Baoding: round rotations; Bounce: bounces) as mean ± s
 roto's published figures on the Shadow. ``overview_table``: the README's few lines, hands by
 (task, obs mode). ``orderings_table``: per (task, hand) the gaps state − blind and touch's effect
 (blind − proprio) with their intervals, and whether state ≥ blind ≥ proprio holds.
-``seeds_table``: Baoding's seeds one by one.
+``seeds_table``: Baoding's seeds one by one. ``variants_table``: each variant beside a baseline
+variant on the seeds both trained (a study's ablations or candidates).
 ``refresh_blocks`` rewrites the generated blocks of a markdown page (between
-``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] -->`` and ``<!-- /roto results -->``)
-from their folders.
+``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] [baseline=VARIANT] -->`` and
+``<!-- /roto results -->``) from their folders.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from roto.olympiad.cell import cell_spec
 from roto.olympiad.path_results import kind_counts, measure_scores, seed_path_kind, with_derived_means
 from roto.olympiad.plan import Cell, Plan, load_plan
 from roto.olympiad.results import cell_statistics, read_summaries
-from roto.olympiad.stats import difference_ci
+from roto.olympiad.stats import difference_ci, paired_difference_ci
 from roto.robots import ROBOTS
 from roto.tasks import TASKS, get_task
 
@@ -239,27 +240,102 @@ def seeds_table(summaries: list[dict]) -> str:
     return "\n".join(lines)
 
 
-TABLES: dict[str, Callable[[list[dict], Plan | None], str]] = {
-    "bounce": lambda summaries, plan: task_table(summaries, "bounce", plan),
-    "baoding": lambda summaries, plan: task_table(summaries, "baoding", plan),
-    "overview": lambda summaries, plan: overview_table(summaries),
-    "orderings": lambda summaries, plan: orderings_table(summaries),
-    "seeds": lambda summaries, plan: seeds_table(summaries),
+def _seed_values(summaries: list[dict], task: str) -> dict[Row, dict[int, float]]:
+    """{(robot, obs, variant): {seed: the task's lead measure of that seed's best policy}}, seeds
+    whose summary neither holds nor can recompute it left out."""
+    found: dict[Row, dict[int, float]] = {}
+    for s in (s for s in summaries if s["task"] == task):
+        value = with_derived_means(task, s["best"]).get(f"{lead_measure(task)}_mean")
+        if value is not None:
+            found.setdefault((s["robot"], s["obs"], s["variant"]), {})[s["seed"]] = value
+    return found
+
+
+def _against(values: dict[int, float], base: dict[int, float]) -> list[str]:
+    """(shared seeds, paired difference with its 95 % interval, seeds better / worse) of one
+    variant's seeds against the baseline's."""
+    shared = sorted(set(values) & set(base))
+    if not shared:
+        return ["none", "", ""]
+    x, y = np.array([values[s] for s in shared]), np.array([base[s] for s in shared])
+    difference = f"{(x - y).mean():+.1f}"
+    interval = "[{:.1f}, {:.1f}]".format(*paired_difference_ci(x, y)) if len(shared) >= 3 else "needs 3 shared seeds"
+    return [", ".join(map(str, shared)), f"{difference} {interval}", f"{int((x > y).sum())} / {int((x < y).sum())}"]
+
+
+def variants_table(summaries: list[dict], baseline: str, plan: Plan | None = None) -> str:
+    """Markdown: per (task, hand, obs mode) that has the ``baseline`` variant, that variant and then
+    every other, each with its config, seeds, lead measure (mean ± std, per seed), seeds by path
+    (Baoding), and against the baseline on the seeds both trained: the mean paired difference
+    with its 95 % bootstrap interval (three shared seeds or more) and how many seeds did better
+    and worse. A change is judged on the same seeds, seed by seed, not only by its mean."""
+    head = ["task", "hand", "obs", "variant", "agent config", "seeds", "mean ± std", "per seed", "seeds by path"]
+    head += [f"seeds shared with {baseline}", "paired difference [95 % CI]", "seeds better / worse"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for task in [t for t in TASKS if any(s["task"] == t for s in summaries)]:
+        values = _seed_values(summaries, task)
+        labels = {(s["robot"], s["obs"], s["variant"]): config_label(s, plan) for s in summaries if s["task"] == task}
+        kinds: dict[Row, list[str | None]] = {}
+        for s in sorted((s for s in summaries if s["task"] == task), key=lambda s: s["seed"]):
+            kinds.setdefault((s["robot"], s["obs"], s["variant"]), []).append(seed_path_kind(task, s))
+        for robot, obs in dict.fromkeys((r, o) for r, o, v in sorted(values, key=_row_order) if v == baseline):
+            rows = sorted((row for row in values if row[:2] == (robot, obs)), key=lambda r: (r[2] != baseline, r[2]))
+            for row in rows:
+                seeds = values[row]
+                scores = np.array([seeds[s] for s in sorted(seeds)])
+                cells = [task, robot, obs, row[2], f"`{labels[row]}`", ", ".join(map(str, sorted(seeds)))]
+                cells += [f"{scores.mean():.1f} ± {scores.std():.1f}", ", ".join(f"{v:.1f}" for v in scores)]
+                cells.append(kind_counts(kinds[row]))
+                base = values[(robot, obs, baseline)]
+                cells += ["(baseline)", "", ""] if row[2] == baseline else _against(seeds, base)
+                lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def _variants(summaries: list[dict], plan: Plan | None, options: dict[str, str]) -> str:
+    if "baseline" not in options:
+        raise ValueError(
+            "a variants block names its baseline variant: <!-- roto results: variants SOURCES baseline=VARIANT -->"
+        )
+    return variants_table(summaries, options["baseline"], plan)
+
+
+TABLES: dict[str, Callable[[list[dict], Plan | None, dict[str, str]], str]] = {
+    "bounce": lambda summaries, plan, options: task_table(summaries, "bounce", plan),
+    "baoding": lambda summaries, plan, options: task_table(summaries, "baoding", plan),
+    "overview": lambda summaries, plan, options: overview_table(summaries),
+    "orderings": lambda summaries, plan, options: orderings_table(summaries),
+    "seeds": lambda summaries, plan, options: seeds_table(summaries),
+    "variants": _variants,
 }
 """The kinds of generated block a page may hold, each a table of its source's summaries."""
-BLOCK = re.compile(r"(<!-- roto results: (\S+) (\S+)(?: plan=(\S+))? -->\n)(.*?)(<!-- /roto results -->)", re.DOTALL)
+BLOCK = re.compile(r"(<!-- roto results: (\S+) (\S+)((?: \w+=\S+)*) -->\n)(.*?)(<!-- /roto results -->)", re.DOTALL)
+OPTIONS = ("plan", "baseline")
+"""What a block's opening may set after its sources: ``plan=PLAN`` (the plan whose configs label
+the rows), ``baseline=VARIANT`` (the variants table's baseline)."""
+
+
+def _options(opening: str, text: str) -> dict[str, str]:
+    """A block's ``key=value`` options; ValueError naming an unknown one."""
+    options = dict(item.split("=", 1) for item in text.split())
+    unknown = sorted(set(options) - set(OPTIONS))
+    if unknown:
+        raise ValueError(f"generated block {opening.strip()!r}: unknown option {unknown[0]!r}; valid: {list(OPTIONS)}")
+    return options
 
 
 def refresh_blocks(text: str, root: str | pathlib.Path) -> str:
     """``text`` with every generated block's table made again from its source folders (relative to
-    ``root``, the repository; several joined by commas); ValueError naming an unknown kind or a
-    folder without summaries."""
+    ``root``, the repository; several joined by commas); ValueError naming an unknown kind or
+    option, or a folder without summaries."""
 
     def table(match: re.Match) -> str:
-        opening, kind, source, plan = match.group(1, 2, 3, 4)
+        opening, kind, source, options = match.group(1, 2, 3, 4)
         if kind not in TABLES:
             raise ValueError(f"generated block {opening.strip()!r}: unknown kind {kind!r}; valid: {sorted(TABLES)}")
+        options = _options(opening, options)
+        plan = load_plan(options["plan"]) if "plan" in options else None
         summaries = [s for folder in source.split(",") for s in read_summaries(pathlib.Path(root) / folder)]
-        return f"{opening}{TABLES[kind](summaries, load_plan(plan) if plan else None)}\n{match.group(6)}"
+        return f"{opening}{TABLES[kind](summaries, plan, options)}\n{match.group(6)}"
 
     return BLOCK.sub(table, text)

@@ -71,3 +71,23 @@ def difference_ci(
     tail = 100.0 * (1.0 - confidence) / 2.0
     low, high = np.percentile(xs - ys, [tail, 100.0 - tail])
     return float(low), float(high)
+
+
+def paired_difference_ci(
+    x: np.ndarray, y: np.ndarray, reps: int = 2000, confidence: float = 0.95, seed: int = 0
+) -> tuple[float, float]:
+    """Percentile bootstrap interval of the mean of x_i - y_i over pairs resampled with replacement
+    (two agents trained on the same seeds: pair i is seed i of each).
+
+    Args:
+        x: (n,) scores of one agent's runs; y: (n,) of the other's on the same seeds, in the same order.
+    """
+    x, y = np.asarray(x, dtype=np.float64).ravel(), np.asarray(y, dtype=np.float64).ravel()
+    if x.shape != y.shape:
+        raise ValueError(f"paired scores need one value per seed on both sides, got {x.size} and {y.size}")
+    differences = x - y
+    rng = np.random.default_rng(seed)
+    means = differences[rng.integers(0, differences.size, size=(reps, differences.size))].mean(axis=1)
+    tail = 100.0 * (1.0 - confidence) / 2.0
+    low, high = np.percentile(means, [tail, 100.0 - tail])
+    return float(low), float(high)

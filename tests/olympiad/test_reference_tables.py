@@ -112,9 +112,8 @@ def test_pages_refresh_their_generated_blocks_from_one_or_more_folders(tmp_path,
     assert main(["results", "--pages", "page.md"]) == 0 and '"changed": []' in capsys.readouterr().out
     page.write_text("<!-- roto results: pie a -->\n<!-- /roto results -->\n")
     assert main(["results", "--pages", "page.md"]) == 2
-    assert (
-        "unknown kind 'pie'; valid: ['baoding', 'bounce', 'orderings', 'overview', 'seeds']" in capsys.readouterr().err
-    )
+    valid = "['baoding', 'bounce', 'orderings', 'overview', 'seeds', 'variants']"
+    assert f"unknown kind 'pie'; valid: {valid}" in capsys.readouterr().err
 
 
 def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_path):
@@ -203,3 +202,43 @@ def test_baoding_tables_count_the_seeds_that_go_round_swing_or_never_swap():
         "round 2, no swaps 1, not measured 1, swing 1"
     )
     assert "seeds by path" not in task_table([older], "baoding") and "by path" not in task_table(SUMMARIES, "bounce")
+
+
+def baoding(variant, seed, rotations, net_turns):
+    best = {"rotations_mean": rotations, "net_turns_mean": net_turns, "round_rotations_mean": min(rotations, net_turns)}
+    return summary("baoding", "shadow", "blind", variant, seed, best, agent={"label": f"cfg_{variant}"})
+
+
+VARIANT_SUMMARIES = [
+    *[baoding("base", s, r, n) for s, r, n in ((0, 3.0, 0.5), (1, 10.0, 11.0), (2, 12.0, 12.5), (3, 14.0, 14.5))],
+    *[baoding("bank", s, r, r + 0.5) for s, r in ((0, 9.0), (1, 11.0), (2, 13.0), (3, 13.0), (7, 8.0))],
+    baoding("other_seeds", 9, 5.0, 5.0),
+]
+
+
+def test_the_variants_table_sets_each_variant_beside_the_baseline_seed_by_seed():
+    from roto.olympiad.reference_tables import variants_table
+
+    lines = variants_table(VARIANT_SUMMARIES, "base").splitlines()
+    assert lines[0].startswith("| task | hand | obs | variant | agent config | seeds | mean ± std | per seed |")
+    assert "seeds shared with base | paired difference [95 % CI] | seeds better / worse |" in lines[0]
+    rows = [[cell.strip() for cell in line.strip("|").split(" | ")] for line in lines[2:]]
+    assert [row[3] for row in rows] == ["base", "bank", "other_seeds"]  # the baseline first
+    base, bank, other = rows
+    # seed 0 of the baseline swings: 0.5 round rotations
+    assert base[5:] == ["0, 1, 2, 3", "9.1 ± 5.2", "0.5, 10.0, 12.0, 14.0", "round 3, swing 1", "(baseline)", "", ""]
+    assert bank[4:9] == ["`cfg_bank`", "0, 1, 2, 3, 7", "10.8 ± 2.0", "9.0, 11.0, 13.0, 13.0, 8.0", "round 5"]
+    # paired on seeds 0-3: +8.5, +1, +1, -1 -> mean +2.4; seed 7 has no pair
+    assert bank[9] == "0, 1, 2, 3" and bank[10].startswith("+2.4 [") and bank[11] == "3 / 1"
+    assert other[9:] == ["none", "", ""]
+
+
+def test_a_variants_block_needs_its_baseline_and_known_options(tmp_path):
+    write_folder(tmp_path / "s", VARIANT_SUMMARIES)
+    text = "<!-- roto results: variants s baseline=base -->\nold\n<!-- /roto results -->\n"
+    fresh = refresh_blocks(text, tmp_path)
+    assert "old" not in fresh and "| baoding | shadow | blind | bank |" in fresh
+    with pytest.raises(ValueError, match="names its baseline variant"):
+        refresh_blocks("<!-- roto results: variants s -->\n<!-- /roto results -->\n", tmp_path)
+    with pytest.raises(ValueError, match=r"unknown option 'baseln'; valid: \['plan', 'baseline'\]"):
+        refresh_blocks("<!-- roto results: variants s baseln=base -->\n<!-- /roto results -->\n", tmp_path)

@@ -45,3 +45,16 @@ def test_the_difference_interval_of_constant_groups_is_their_difference_and_wide
     assert difference_ci([5.0, 5.0, 5.0], [2.0, 2.0]) == (3.0, 3.0)
     low, high = difference_ci([4.0, 6.0, 5.0, 7.0], [1.0, 3.0, 2.0])
     assert 1.0 <= low < 5.5 - 2.0 < high <= 6.0  # around the difference of means, within 4 - 3 and 7 - 1
+
+
+def test_the_paired_interval_resamples_seed_pairs_not_groups():
+    import pytest
+
+    from roto.olympiad.stats import paired_difference_ci
+
+    # every seed gains exactly 2 while the seeds themselves spread widely: the pairs leave no doubt
+    assert paired_difference_ci([12.0, 1.0, 30.0], [10.0, -1.0, 28.0]) == (2.0, 2.0)
+    low, high = paired_difference_ci([3.0, 5.0, 4.0, 9.0], [1.0, 1.0, 1.0, 1.0])
+    assert 2.0 <= low < 4.25 < high <= 8.0  # around the mean difference, within the smallest and largest
+    with pytest.raises(ValueError, match="one value per seed on both sides, got 3 and 2"):
+        paired_difference_ci([1.0, 2.0, 3.0], [1.0, 2.0])
