@@ -31,7 +31,13 @@ SUCCESS_RADIUS = 0.01
 """A ball within this distance of its current target sets its latch (m)."""
 SWAP_REWARD = 10.0
 PARAMETER_FIELDS = MappingProxyType(
-    {"success_radius": "radius", "swap_min_turn": "min_turn", "turn_reward": "turn_reward", "turn_lead": "turn_lead"}
+    {
+        "success_radius": "radius",
+        "swap_min_turn": "min_turn",
+        "swap_first_paid": "first_paid",
+        "turn_reward": "turn_reward",
+        "turn_lead": "turn_lead",
+    }
 )
 """{task parameter: the ``BaodingState`` field that holds it}."""
 UNBOUNDED_LEAD = 1e9
@@ -138,6 +144,7 @@ class BaodingState:
     turned: torch.Tensor  # (B,) float64: the line's signed turns since the last paid swap
     direction: torch.Tensor  # (B,) float64: +1 or -1, the way round of the first paid swap; 0 before it
     min_turn: torch.Tensor  # () float64: turns a paid swap must follow (0: every swap is paid)
+    first_paid: torch.Tensor  # () float64: > 0 pays an episode's first swap whatever turned before it
     # the turn-shaping training aid (roto.tasks.round_swaps.turn_shaping); turn_reward 0 (the benchmark) pays nothing
     net_turn: torch.Tensor  # (B,) float64: the line's signed turns this episode
     turn_reward: torch.Tensor  # () float64: reward per turn the pair's net turning grows by
@@ -178,7 +185,9 @@ def follow_turns(state: BaodingState, pos: Array, swap: Array) -> dict[str, Arra
     (B,): 0 while ``turn_reward`` is 0). ``pos`` (B, 2, 3) ball centres, ``swap`` (B,) bool."""
     state.pair_angle, turn = pair_turn_step(pos, state.pair_angle, state.angle_set)
     state.angle_set = state.angle_set | True
-    paid, state.turned, state.direction = paid_swaps(swap, state.turned + turn, state.direction, state.min_turn)
+    paid, state.turned, state.direction = paid_swaps(
+        swap, state.turned + turn, state.direction, state.min_turn, state.first_paid
+    )
     paid_turns = state.turn_lead + 0.5 * as_dtype_of(state.swaps, pos)  # turns the swaps so far back
     before = paid_turns - 0.5 * as_dtype_of(swap, pos)  # the bound before this step's swap
     shaped, state.net_turn = turn_shaping(state.net_turn, turn, state.turn_reward, before, paid_turns)
@@ -196,11 +205,18 @@ class Baoding:
     metric_names = ("swaps", "rotations")
     headline_metric = "rotations"
     parameters = MappingProxyType(
-        {"success_radius": SUCCESS_RADIUS, "swap_min_turn": 0.0, "turn_reward": 0.0, "turn_lead": UNBOUNDED_LEAD}
+        {
+            "success_radius": SUCCESS_RADIUS,
+            "swap_min_turn": 0.0,
+            "swap_first_paid": 0.0,
+            "turn_reward": 0.0,
+            "turn_lead": UNBOUNDED_LEAD,
+        }
     )
     """What training aids may change: the latch radius (m; a tolerance curriculum starts it wider,
     ``roto.envs.aids.tolerance``), the turns a paid swap must follow (0: every swap is paid; the
-    round-swaps aid sets it, ``roto.tasks.round_swaps``) and the reward per turn of the pair's net
+    round-swaps aid sets it, ``roto.tasks.round_swaps``), whether an episode's first swap is paid
+    without them (0: no; the same aid) and the reward per turn of the pair's net
     turning (0: none; the turn-shaping aid sets it, ``roto.tasks.round_swaps.turn_shaping``)."""
     reference_name = "reference controller"
 
@@ -240,14 +256,15 @@ class Baoding:
             turned=torch.zeros(num_envs, dtype=torch.float64, device=device),
             direction=torch.zeros(num_envs, dtype=torch.float64, device=device),
             min_turn=torch.zeros((), dtype=torch.float64, device=device),
+            first_paid=torch.zeros((), dtype=torch.float64, device=device),
             net_turn=torch.zeros(num_envs, dtype=torch.float64, device=device),
             turn_reward=torch.zeros((), dtype=torch.float64, device=device),
             turn_lead=torch.tensor(UNBOUNDED_LEAD, dtype=torch.float64, device=device),
         )
 
     def set_parameter(self, state: BaodingState, name: str, value: float | torch.Tensor) -> None:
-        """Set ``success_radius``, ``swap_min_turn``, ``turn_reward`` or ``turn_lead`` of every world
-        (``Task.set_parameter``)."""
+        """Set ``success_radius``, ``swap_min_turn``, ``swap_first_paid``, ``turn_reward`` or
+        ``turn_lead`` of every world (``Task.set_parameter``)."""
         set_state_parameter(state, PARAMETER_FIELDS, name, value)
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:

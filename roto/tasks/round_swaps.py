@@ -40,7 +40,9 @@ def pair_turn_step(ball_pos: Array, pair_angle: Array, angle_set: Array) -> tupl
     return angle, where(angle_set, step / (2.0 * math.pi), 0.0)
 
 
-def paid_swaps(swap: Array, turned: Array, direction: Array, min_turn: float | Array) -> tuple[Array, Array, Array]:
+def paid_swaps(
+    swap: Array, turned: Array, direction: Array, min_turn: float | Array, first_paid: float | Array = 0.0
+) -> tuple[Array, Array, Array]:
     """Which swaps earn their reward (pure; torch or numpy).
 
     Args:
@@ -48,12 +50,15 @@ def paid_swaps(swap: Array, turned: Array, direction: Array, min_turn: float | A
         turned: (B,) signed turns of the ball line since the last paid swap, this step's included.
         direction: (B,) +1 or -1, the way round of the episode's first paid swap; 0 before it.
         min_turn: the turns a paid swap must follow, the same way round; 0 pays every swap.
+        first_paid: > 0: an episode's first swap is paid however little the line turned before it
+            (its way round, the sign of ``turned``, becomes the episode's); 0: it too must follow
+            ``min_turn``.
 
     Returns:
         (paid (B,) bool, new turned (0 where paid), new direction)
     """
     way = where(direction == 0, where(turned >= 0, 1.0, -1.0), direction)
-    paid = swap & ((min_turn <= 0) | (turned * way >= min_turn))
+    paid = swap & ((min_turn <= 0) | (turned * way >= min_turn) | ((first_paid > 0) & (direction == 0)))
     return paid, where(paid, 0.0, turned), where(paid, way, direction)
 
 

@@ -359,11 +359,11 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
         "orca_round_preswap",
     )
     expected = {
-        "round_swaps": {"env.aids.round_swaps": ({"min_turn": 0.25}, None)},
+        "round_swaps": {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False}, None)},
         "round_bank": {"env.aids.replayed_starts.bank": (round_bank, bank)},
         "round_bank_round_swaps": {
             "env.aids.replayed_starts.bank": (round_bank, bank),
-            "env.aids.round_swaps": ({"min_turn": 0.25}, None),
+            "env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False}, None),
         },
     }
     assert [(c.variant, c.seed) for c in plan.cells] == [
@@ -397,7 +397,7 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
     round_bank = "shadow_round_preswap"
     assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
         "env.aids.replayed_starts.bank": (round_bank, recipe.env.aids.replayed_starts.bank),
-        "env.aids.round_swaps": ({"min_turn": 0.25}, None),
+        "env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False}, None),
         "env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None}),  # the recipe's since it ran
         "env.seed": (3, 0),
     }  # fmt: skip

@@ -31,13 +31,13 @@ def test_the_line_turns_the_shorter_way_across_the_branch_cut_and_not_on_an_epis
     assert float(turn[0]) == pytest.approx(-0.1)
 
 
-def run_rule(turns_between_swaps, min_turn):
+def run_rule(turns_between_swaps, min_turn, first_paid=0.0):
     """Paid flags of a sequence of swaps, each after the given signed turns of the line."""
     turned = torch.zeros(1, dtype=torch.float64)
     direction = torch.zeros(1, dtype=torch.float64)
     paid_flags = []
     for turn in turns_between_swaps:
-        paid, turned, direction = paid_swaps(torch.tensor([True]), turned + turn, direction, min_turn)
+        paid, turned, direction = paid_swaps(torch.tensor([True]), turned + turn, direction, min_turn, first_paid)
         paid_flags.append(bool(paid[0]))
     return paid_flags
 
@@ -53,6 +53,16 @@ def test_a_pair_swung_out_and_back_is_paid_once_and_without_the_aid_every_time()
     assert run_rule(swing, 0.0) == [True] * 8
     # a swing that turns back and then goes on round the first way is paid again once it has gone far enough
     assert run_rule([0.3, -0.3, 0.3, 0.5], 0.25) == [True, False, False, True]
+
+
+def test_with_first_paid_an_episodes_first_swap_pays_after_any_turn_and_sets_the_way_round():
+    # a replayed start a few steps before a swap: the first swap follows a tenth of a turn
+    assert run_rule([0.1, 0.5, 0.5], 0.25) == [False, True, True]  # without: its reward withheld
+    assert run_rule([0.1, 0.5, 0.5], 0.25, first_paid=1.0) == [True, True, True]
+    # the first swap's way round (here clockwise, -0.1) is the episode's: a swing back is not paid
+    assert run_rule([-0.1, 0.5, -0.5, -0.5], 0.25, first_paid=1.0) == [True, False, False, True]
+    swing = [0.1, -0.3, 0.3, -0.3, 0.3]  # out and back along one arc: paid once an episode, as before
+    assert run_rule(swing, 0.25, first_paid=1.0) == [True, False, False, False, False]
 
 
 def test_a_step_without_a_swap_pays_nothing_and_keeps_counting_the_turn():
@@ -113,7 +123,9 @@ def test_the_task_pays_every_round_swap_one_swing_and_counts_all_swaps():
 
 def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids={"round_swaps": {"min_turn": 0.25}})
-    assert float(env.task_state.min_turn) == 0.25
+    assert float(env.task_state.min_turn) == 0.25 and float(env.task_state.first_paid) == 0.0
+    aids = {"round_swaps": {"min_turn": 0.25, "first_paid": True}}
+    assert float(roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids=aids).task_state.first_paid) == 1.0
     assert float(roto.make("baoding", robot="shadow", num_envs=2, seed=0).task_state.min_turn) == 0.0
     settings = RunSpec(env=EnvConfig(task="baoding", aids={"round_swaps": {}}))  # a quarter turn by default
     assert (
@@ -132,3 +144,8 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
 def test_bad_swap_min_turn_is_refused(task, min_turn, pattern):
     with pytest.raises(ValueError, match=pattern):
         EnvConfig(task=task, aids={"round_swaps": {"min_turn": min_turn}})
+
+
+def test_a_first_paid_that_is_not_true_or_false_is_refused():
+    with pytest.raises(ValueError, match=r"aids.round_swaps.first_paid must be true or false, got 'yes'"):
+        EnvConfig(task="baoding", aids={"round_swaps": {"first_paid": "yes"}})

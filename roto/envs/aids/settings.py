@@ -103,13 +103,19 @@ class RoundSwapsSettings:
         min_turn: the turns of the line between the balls, since the last paid swap and the same
             way round as the episode's first, that a paid swap must follow (a pair carried round
             turns half a turn a swap; one swung out and back is paid once an episode).
+        first_paid: an episode's first swap is paid however little the pair turned before it (its
+            way round becomes the episode's): a replayed start, a few control steps before a swap,
+            keeps its swap's reward, which ``min_turn`` alone would withhold.
     """
 
     min_turn: float = 0.25
+    first_paid: bool = False
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "swap_min_turn", "swaps")
         _number(f"{path}.min_turn", self.min_turn, 0.0, 0.5, "a number of turns")
+        if not isinstance(self.first_paid, bool):
+            raise ValueError(f"{path}.first_paid must be true or false, got {self.first_paid!r}")
 
 
 @dataclass(frozen=True, kw_only=True)
