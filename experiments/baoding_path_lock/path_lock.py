@@ -5,8 +5,8 @@ its ``best.pt`` over 100 fresh episodes.
 
     python experiments/baoding_path_lock/path_lock.py > experiments/baoding_path_lock/path_lock.md
 
-A path is "round" where the mean net turns are at least 0.8 of the mean rotations (the issue's bar
-for a policy that does not swing), "swing" where not, "none" below one rotation.
+A path is Baoding's ``Task.path_kind`` of an evaluation's means: "round" where the mean net turns
+are at least 0.8 of the mean rotations, "swing" where not, "no swaps" below one rotation.
 """
 
 from __future__ import annotations
@@ -14,16 +14,15 @@ from __future__ import annotations
 import json
 import pathlib
 
+from roto.tasks import get_task
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-ROUND_SHARE = 0.8
 LATER = 3
 
 
 def path(rotations: float, net_turns: float) -> str:
-    """The path kind of one evaluation's means."""
-    if rotations < 1.0:
-        return "none"
-    return "round" if net_turns >= ROUND_SHARE * rotations else "swing"
+    """The path kind of one evaluation's means (the task's own rule)."""
+    return get_task("baoding").path_kind({"rotations": rotations, "net_turns": net_turns})
 
 
 def row(summary: dict, name: str) -> str | None:
