@@ -53,20 +53,28 @@ def path_metric_table(summaries: list[dict]) -> list[str]:
     return lines
 
 
+def seed_measures(
+    summaries: Iterable[dict], task: str, measure: str, policy: str = "best"
+) -> dict[tuple[str, str, str], dict[int, float | None]]:
+    """{(robot, obs, variant): {seed: ``measure`` of that seed's ``policy`` ("final" or "best") on
+    ``task``, None where its summary neither holds nor can recompute it (``with_derived_means``)}}."""
+    found: dict[tuple[str, str, str], dict[int, float | None]] = {}
+    for s in summaries:
+        if s["task"] == task:
+            value = with_derived_means(task, s[policy]).get(f"{measure}_mean")
+            found.setdefault((s["robot"], s["obs"], s["variant"]), {})[s["seed"]] = value
+    return found
+
+
 def measure_scores(
     summaries: Iterable[dict], task: str, measure: str, policy: str = "best"
 ) -> dict[tuple[str, str, str], np.ndarray | None]:
     """{(robot, obs, variant): (seeds,) ``measure`` of each seed's ``policy`` ("final" or "best") on
     ``task``, seeds in order; None where some seed's summary neither holds nor can recompute it
-    (``with_derived_means``)."""
-    found: dict[tuple[str, str, str], list[tuple[int, float | None]]] = {}
-    for s in summaries:
-        if s["task"] == task:
-            value = with_derived_means(task, s[policy]).get(f"{measure}_mean")
-            found.setdefault((s["robot"], s["obs"], s["variant"]), []).append((s["seed"], value))
+    (``seed_measures``)."""
     return {
-        row: None if any(v is None for _, v in runs) else np.array([v for _, v in sorted(runs)])
-        for row, runs in found.items()
+        row: None if None in seeds.values() else np.array([seeds[seed] for seed in sorted(seeds)])
+        for row, seeds in seed_measures(summaries, task, measure, policy).items()
     }
 
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from roto.envs.observations import OBS_MODES
 from roto.olympiad.cell import cell_spec
-from roto.olympiad.path_results import kind_counts, measure_scores, seed_path_kind, with_derived_means
+from roto.olympiad.path_results import kind_counts, measure_scores, seed_measures, seed_path_kind, with_derived_means
 from roto.olympiad.plan import Cell, Plan, load_plan
 from roto.olympiad.results import cell_statistics, read_summaries
 from roto.olympiad.stats import difference_ci, paired_difference_ci
@@ -240,17 +240,6 @@ def seeds_table(summaries: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def _seed_values(summaries: list[dict], task: str) -> dict[Row, dict[int, float]]:
-    """{(robot, obs, variant): {seed: the task's lead measure of that seed's best policy}}, seeds
-    whose summary neither holds nor can recompute it left out."""
-    found: dict[Row, dict[int, float]] = {}
-    for s in (s for s in summaries if s["task"] == task):
-        value = with_derived_means(task, s["best"]).get(f"{lead_measure(task)}_mean")
-        if value is not None:
-            found.setdefault((s["robot"], s["obs"], s["variant"]), {})[s["seed"]] = value
-    return found
-
-
 def _against(values: dict[int, float], base: dict[int, float]) -> list[str]:
     """(shared seeds, paired difference with its 95 % interval, seeds better / worse) of one
     variant's seeds against the baseline's."""
@@ -273,10 +262,11 @@ def variants_table(summaries: list[dict], baseline: str, plan: Plan | None = Non
     head += [f"seeds shared with {baseline}", "paired difference [95 % CI]", "seeds better / worse"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for task in [t for t in TASKS if any(s["task"] == t for s in summaries)]:
-        values = _seed_values(summaries, task)
+        measured = seed_measures(summaries, task, lead_measure(task)).items()
+        values = {row: {seed: v for seed, v in seeds.items() if v is not None} for row, seeds in measured}
         labels = {(s["robot"], s["obs"], s["variant"]): config_label(s, plan) for s in summaries if s["task"] == task}
         kinds: dict[Row, list[str | None]] = {}
-        for s in sorted((s for s in summaries if s["task"] == task), key=lambda s: s["seed"]):
+        for s in (s for s in summaries if s["task"] == task):  # counted, so in any order
             kinds.setdefault((s["robot"], s["obs"], s["variant"]), []).append(seed_path_kind(task, s))
         for robot, obs in dict.fromkeys((r, o) for r, o, v in sorted(values, key=_row_order) if v == baseline):
             rows = sorted((row for row in values if row[:2] == (robot, obs)), key=lambda r: (r[2] != baseline, r[2]))

@@ -10,6 +10,13 @@ from __future__ import annotations
 import numpy as np
 
 
+def percentile_interval(values: np.ndarray, confidence: float) -> tuple[float, float]:
+    """The central ``confidence`` share of bootstrap statistics ``values`` (reps,): their percentiles."""
+    tail = 100.0 * (1.0 - confidence) / 2.0
+    low, high = np.percentile(values, [tail, 100.0 - tail])
+    return float(low), float(high)
+
+
 def iqm(scores: np.ndarray) -> float:
     """Interquartile mean of every score: drop the lowest and highest floor(n / 4) of the n values
     (scipy's ``trim_mean(x, 0.25)``, which rliable uses), average the rest.
@@ -36,10 +43,7 @@ def stratified_bootstrap_ci(
     rng = np.random.default_rng(seed)
     picks = rng.integers(0, runs, size=(reps, runs, tasks))  # run index per resample, slot and task
     resampled = np.take_along_axis(np.broadcast_to(scores, (reps, runs, tasks)), picks, axis=1)
-    values = np.array([statistic(sample) for sample in resampled])
-    tail = 100.0 * (1.0 - confidence) / 2.0
-    low, high = np.percentile(values, [tail, 100.0 - tail])
-    return float(low), float(high)
+    return percentile_interval(np.array([statistic(sample) for sample in resampled]), confidence)
 
 
 def probability_of_improvement(x: np.ndarray, y: np.ndarray) -> float:
@@ -68,9 +72,7 @@ def difference_ci(
     rng = np.random.default_rng(seed)
     xs = x[rng.integers(0, x.size, size=(reps, x.size))].mean(axis=1)
     ys = y[rng.integers(0, y.size, size=(reps, y.size))].mean(axis=1)
-    tail = 100.0 * (1.0 - confidence) / 2.0
-    low, high = np.percentile(xs - ys, [tail, 100.0 - tail])
-    return float(low), float(high)
+    return percentile_interval(xs - ys, confidence)
 
 
 def paired_difference_ci(
@@ -88,6 +90,4 @@ def paired_difference_ci(
     differences = x - y
     rng = np.random.default_rng(seed)
     means = differences[rng.integers(0, differences.size, size=(reps, differences.size))].mean(axis=1)
-    tail = 100.0 * (1.0 - confidence) / 2.0
-    low, high = np.percentile(means, [tail, 100.0 - tail])
-    return float(low), float(high)
+    return percentile_interval(means, confidence)
