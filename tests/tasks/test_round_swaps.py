@@ -92,10 +92,11 @@ def path_round_the_targets(thetas):
     return torch.stack(out)
 
 
-def swap_rewards(path, min_turn):
+def swap_rewards(path, min_turn, first_paid=False):
     task = Baoding()
     state = task.init_state(SHADOW, 1, torch.device("cpu"))
     state.min_turn.fill_(min_turn)
+    task.set_parameter(state, "swap_first_paid", float(first_paid))
     rewards = []
     for pos in path:
         inputs = TaskInputs(
@@ -119,6 +120,15 @@ def test_the_task_pays_every_round_swap_one_swing_and_counts_all_swaps():
     assert swaps == 3 and sum(rewards) == 3 * SWAP_REWARD
     rewards, swaps = swap_rewards(swing_path, 0.25)  # out (paid), back, out again: swaps both, paid neither
     assert swaps == 3 and sum(rewards) == SWAP_REWARD
+
+
+def test_the_task_pays_a_replayed_starts_first_swap_only_with_first_paid():
+    # a start a twentieth of a turn before a swap (as a replayed start is), then carried round
+    path = path_round_the_targets(np.linspace(1.9 * math.pi, 4.0 * math.pi, 64))
+    rewards, swaps = swap_rewards(path, 0.25)
+    assert swaps == 3 and rewards[0] == 0.0 and sum(rewards) == 2 * SWAP_REWARD
+    rewards, swaps = swap_rewards(path, 0.25, first_paid=True)
+    assert swaps == 3 and rewards[0] == SWAP_REWARD and sum(rewards) == 3 * SWAP_REWARD
 
 
 def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
