@@ -478,15 +478,17 @@ def test_baoding_cpu_is_what_the_every_hand_and_small_net_studies_trained():
         assert cell_spec(small_net, cell).differences(recipe) == {}
 
 
-def test_the_first_paid_plan_is_baoding_cpu_with_round_swaps_paying_the_first_swap():
-    """Its cells differ from baoding_cpu, the recipe experiments/baoding_small_net trained on the same
-    seeds, only by the round-swaps aid with first_paid, so the two pair seed by seed."""
+def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_swap():
+    """Their cells differ from baoding_cpu, the recipe experiments/baoding_small_net (seeds 0-4) and
+    experiments/baoding_round_bank (seeds 5-9) trained on the same seeds, only by the round-swaps
+    aid with first_paid, so the two pair seed by seed."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
-    plan = plan_named("first_paid")
-    assert [(c.robot, c.seed) for c in plan.cells] == [("shadow", seed) for seed in range(5)]
-    recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu", [], plan.steps, num_envs=128, threads=1)
-    for cell in plan.cells:
-        differences = cell_spec(plan, cell).differences(recipe.with_seed(cell.seed))
-        assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True}, None)}
+    for name, seeds in (("first_paid", range(5)), ("first_paid_untuned", range(5, 10))):
+        plan = plan_named(name)
+        assert [(c.robot, c.variant, c.seed) for c in plan.cells] == [("shadow", "first_paid", s) for s in seeds]
+        recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu", [], plan.steps, num_envs=128, threads=1)
+        for cell in plan.cells:
+            differences = cell_spec(plan, cell).differences(recipe.with_seed(cell.seed))
+            assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True}, None)}
