@@ -9,12 +9,13 @@ roto's published figures on the Shadow. ``overview_table``: the README's few lin
 ``seeds_table``: Baoding's seeds one by one. ``variants_table``: each variant beside a baseline
 variant on the seeds both trained (a study's ablations or candidates).
 ``refresh_blocks`` rewrites the generated blocks of a markdown page (between
-``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN] [baseline=VARIANT] -->`` and
+``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN[,PLAN...]] [baseline=VARIANT] -->`` and
 ``<!-- /roto results -->``) from their folders.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import pathlib
 import re
 from collections.abc import Callable
@@ -301,8 +302,21 @@ TABLES: dict[str, Callable[[list[dict], Plan | None, dict[str, str]], str]] = {
 """The kinds of generated block a page may hold, each a table of its source's summaries."""
 BLOCK = re.compile(r"(<!-- roto results: (\S+) (\S+)((?: \w+=\S+)*) -->\n)(.*?)(<!-- /roto results -->)", re.DOTALL)
 OPTIONS = ("plan", "baseline")
-"""What a block's opening may set after its sources: ``plan=PLAN`` (the plan whose configs label
-the rows), ``baseline=VARIANT`` (the variants table's baseline)."""
+"""What a block's opening may set after its sources: ``plan=PLAN[,PLAN...]`` (the plans whose
+configs label the rows), ``baseline=VARIANT`` (the variants table's baseline)."""
+
+
+def joined_plans(names: str) -> Plan:
+    """The plans ``names`` (comma-separated names or files) as one whose variants are all of theirs,
+    so that rows from several studies each name their own config; ValueError where two of them
+    train a variant of the same name differently."""
+    plans = [load_plan(name) for name in names.split(",")]
+    variants = dict(plans[0].variants)
+    for plan in plans[1:]:
+        for name, variant in plan.variants.items():
+            if variants.setdefault(name, variant) != variant:
+                raise ValueError(f"plans {names!r} both have a variant {name!r}, trained differently; name one plan")
+    return dataclasses.replace(plans[0], variants=variants)
 
 
 def _options(opening: str, text: str) -> dict[str, str]:
@@ -324,7 +338,7 @@ def refresh_blocks(text: str, root: str | pathlib.Path) -> str:
         if kind not in TABLES:
             raise ValueError(f"generated block {opening.strip()!r}: unknown kind {kind!r}; valid: {sorted(TABLES)}")
         options = _options(opening, options)
-        plan = load_plan(options["plan"]) if "plan" in options else None
+        plan = joined_plans(options["plan"]) if "plan" in options else None
         summaries = [s for folder in source.split(",") for s in read_summaries(pathlib.Path(root) / folder)]
         return f"{opening}{TABLES[kind](summaries, plan, options)}\n{match.group(6)}"
 

@@ -242,3 +242,34 @@ def test_a_variants_block_needs_its_baseline_and_known_options(tmp_path):
         refresh_blocks("<!-- roto results: variants s -->\n<!-- /roto results -->\n", tmp_path)
     with pytest.raises(ValueError, match=r"unknown option 'baseln'; valid: \['plan', 'baseline'\]"):
         refresh_blocks("<!-- roto results: variants s baseln=base -->\n<!-- /roto results -->\n", tmp_path)
+
+
+def plan_file(path, variants: dict[str, str]):
+    """A one-cell-per-variant Baoding plan at ``path``: variant name -> its agent config line."""
+    lines = ["steps: 1000", "variants:"]
+    lines += [f"  {name}:\n    baoding: {{agent_cfg: {agent}}}" for name, agent in variants.items()]
+    lines += [
+        "grids:",
+        f"  - {{tasks: [baoding], robots: [shadow], obs: [blind], variants: [{', '.join(variants)}], seeds: [0]}}",
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    return str(path)
+
+
+def test_a_block_labels_each_variant_from_whichever_of_its_plans_trains_it(tmp_path):
+    """Rows from two studies name each one's own config, not the one their summaries recorded."""
+    write_folder(tmp_path / "s", VARIANT_SUMMARIES)
+    one = plan_file(tmp_path / "one.yaml", {"base": "baoding_cpu_v1", "other_seeds": "baoding_cpu_v1"})
+    two = plan_file(tmp_path / "two.yaml", {"bank": "baoding_cpu", "other_seeds": "baoding_cpu_v1"})
+    text = f"<!-- roto results: variants s plan={one},{two} baseline=base -->\n<!-- /roto results -->\n"
+    rows = [line.split(" | ") for line in refresh_blocks(text, tmp_path).splitlines() if line.startswith("| baoding")]
+    assert [(row[3], row[4]) for row in rows] == [
+        ("base", "`baoding_cpu_v1`"),
+        ("bank", "`baoding_cpu`"),
+        ("other_seeds", "`baoding_cpu_v1`"),
+    ]
+    clash = plan_file(tmp_path / "clash.yaml", {"base": "baoding_cpu"})
+    with pytest.raises(ValueError, match="both have a variant 'base', trained differently"):
+        refresh_blocks(
+            f"<!-- roto results: variants s plan={one},{clash} baseline=base -->\n<!-- /roto results -->\n", tmp_path
+        )
