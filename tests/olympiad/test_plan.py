@@ -447,47 +447,92 @@ def test_the_benchmark_plan_trains_every_hand_and_mode_with_its_record_s_recipe_
     assert len(shared) == 24 and all(cell_spec(plan, c).differences(cell_spec(cpu, c)) == {} for c in shared)
 
 
-def test_baoding_cpu_is_what_the_every_hand_and_small_net_studies_trained():
+def test_baoding_cpu_is_what_the_round_bank_study_trained_and_before_its_round_bank_what_the_others_did():
     """The packaged one-for-every-hand recipe is, on each hand, the Shadow's recipe with the hand's
-    own bank and the smaller encoder: what the every-hand pilot trained on its seed-0 cells (as
-    overrides of baoding_cpu_shadow) and the small-net study on the Shadow, so their results are
-    baoding_cpu's."""
+    round bank and the smaller encoder: what experiments/baoding_round_bank trained as
+    small_round_bank (as overrides of baoding_cpu_shadow), so its results are baoding_cpu's. With the
+    hand's swinging bank pinned, it is what the every-hand pilot, the small-net study and the round
+    bank's paired baseline trained (baoding_cpu before that study's decision)."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
     small = ["network.encoder=[512, 256, 128]"]
     for robot in ROBOTS:
         recipe = build_run_spec("baoding", robot, "blind", "baoding_cpu", [], 10_000_000, num_envs=128, threads=1)
-        pilot = [f"env.aids.replayed_starts.bank={robot}_preswap", *small]
-        as_trained = build_run_spec(
-            "baoding", robot, "blind", "baoding_cpu_shadow", pilot, 10_000_000, num_envs=128, threads=1
-        )
-        assert recipe.differences(as_trained) == {}
-        assert recipe.env.aids.replayed_starts.bank == f"{robot}_preswap"
-    study = plan_named("every_hand")
+        assert recipe.env.aids.replayed_starts.bank == f"{robot}_round_preswap"
+        for bank in (f"{robot}_round_preswap", f"{robot}_preswap"):
+            pinned = build_run_spec(
+                "baoding",
+                robot,
+                "blind",
+                "baoding_cpu",
+                [f"env.aids.replayed_starts.bank={bank}"],
+                10_000_000,
+                num_envs=128,
+                threads=1,
+            )
+            as_trained = build_run_spec(
+                "baoding",
+                robot,
+                "blind",
+                "baoding_cpu_shadow",
+                [f"env.aids.replayed_starts.bank={bank}", *small],
+                10_000_000,
+                num_envs=128,
+                threads=1,
+            )
+            assert pinned.differences(as_trained) == {}
+    study = plan_named("round_bank")
     for cell in study.cells:
         recipe = build_run_spec(
             "baoding", cell.robot, "blind", "baoding_cpu", [], 1, num_envs=128, threads=1, seed=cell.seed
         )
-        assert cell_spec(study, cell).differences(recipe) == {}
-    small_net = plan_named("small_net")
-    for cell in small_net.cells:
-        recipe = build_run_spec(
-            "baoding", "shadow", "blind", "baoding_cpu", [], 1, num_envs=128, threads=1, seed=cell.seed
-        )
-        assert cell_spec(small_net, cell).differences(recipe) == {}
+        differences = cell_spec(study, cell).differences(recipe)
+        swinging = {"env.aids.replayed_starts.bank": ("shadow_preswap", "shadow_round_preswap")}
+        assert differences == ({} if cell.variant == "small_round_bank" else swinging)
+    for name in ("every_hand", "small_net"):
+        study = plan_named(name)
+        for cell in study.cells:
+            before = build_run_spec(
+                "baoding",
+                cell.robot,
+                "blind",
+                "baoding_cpu",
+                [f"env.aids.replayed_starts.bank={cell.robot}_preswap"],
+                1,
+                num_envs=128,
+                threads=1,
+                seed=cell.seed,
+            )
+            assert cell_spec(study, cell).differences(before) == {}
 
 
 def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_swap():
-    """Their cells differ from baoding_cpu, the recipe experiments/baoding_small_net (seeds 0-4) and
-    experiments/baoding_round_bank (seeds 5-9) trained on the same seeds, only by the round-swaps
-    aid with first_paid, so the two pair seed by seed."""
+    """Their cells differ from baoding_cpu with the swinging bank, the recipe experiments/baoding_small_net
+    (seeds 0-4) and experiments/baoding_round_bank (seeds 5-9) trained on the same seeds, only by the
+    round-swaps aid with first_paid, so the two pair seed by seed."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
     for name, seeds in (("first_paid", range(5)), ("first_paid_untuned", range(5, 10))):
         plan = plan_named(name)
         assert [(c.robot, c.variant, c.seed) for c in plan.cells] == [("shadow", "first_paid", s) for s in seeds]
+        pin = ["env.aids.replayed_starts.bank=shadow_preswap"]  # baoding_cpu before its round bank
+        recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu", pin, plan.steps, num_envs=128, threads=1)
+        for cell in plan.cells:
+            differences = cell_spec(plan, cell).differences(recipe.with_seed(cell.seed))
+            assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True}, None)}
+
+
+def test_the_round_recipe_plans_are_baoding_cpu_with_round_swaps_paying_the_first_swap():
+    """experiments/baoding_round_recipe's cells differ from today's baoding_cpu (the round bank's
+    small_round_bank runs on seeds 0 and 5-9) only by the round-swaps aid with first_paid."""
+    from roto.olympiad.cell import cell_spec
+    from roto.rl.run_spec import build_run_spec
+
+    for name, seeds in (("round_recipe", range(5)), ("round_recipe_untuned", range(5, 10))):
+        plan = plan_named(name)
+        assert [(c.robot, c.variant, c.seed) for c in plan.cells] == [("shadow", "round_first_paid", s) for s in seeds]
         recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu", [], plan.steps, num_envs=128, threads=1)
         for cell in plan.cells:
             differences = cell_spec(plan, cell).differences(recipe.with_seed(cell.seed))
