@@ -447,6 +447,13 @@ def test_the_benchmark_plan_trains_every_hand_and_mode_with_its_record_s_recipe_
     assert len(shared) == 24 and all(cell_spec(plan, c).differences(cell_spec(cpu, c)) == {} for c in shared)
 
 
+def blind_baoding(robot: str, config: str, overrides: list[str] = (), steps: int = 1, seed: int = 0):
+    """The run spec of a blind Baoding cell as roto's Baoding studies train it (128 envs, one thread)."""
+    from roto.rl.run_spec import build_run_spec
+
+    return build_run_spec("baoding", robot, "blind", config, list(overrides), steps, num_envs=128, threads=1, seed=seed)
+
+
 def test_baoding_cpu_is_what_the_round_bank_study_trained_and_before_its_round_bank_what_the_others_did():
     """The packaged one-for-every-hand recipe is, on each hand, the Shadow's recipe with the hand's
     round bank and the smaller encoder: what experiments/baoding_round_bank trained as
@@ -454,86 +461,44 @@ def test_baoding_cpu_is_what_the_round_bank_study_trained_and_before_its_round_b
     hand's swinging bank pinned, it is what the every-hand pilot, the small-net study and the round
     bank's paired baseline trained (baoding_cpu before that study's decision)."""
     from roto.olympiad.cell import cell_spec
-    from roto.rl.run_spec import build_run_spec
 
-    small = ["network.encoder=[512, 256, 128]"]
     for robot in ROBOTS:
-        recipe = build_run_spec("baoding", robot, "blind", "baoding_cpu", [], 10_000_000, num_envs=128, threads=1)
-        assert recipe.env.aids.replayed_starts.bank == f"{robot}_round_preswap"
+        assert blind_baoding(robot, "baoding_cpu").env.aids.replayed_starts.bank == f"{robot}_round_preswap"
         for bank in (f"{robot}_round_preswap", f"{robot}_preswap"):
-            pinned = build_run_spec(
-                "baoding",
-                robot,
-                "blind",
-                "baoding_cpu",
-                [f"env.aids.replayed_starts.bank={bank}"],
-                10_000_000,
-                num_envs=128,
-                threads=1,
-            )
-            as_trained = build_run_spec(
-                "baoding",
-                robot,
-                "blind",
-                "baoding_cpu_shadow",
-                [f"env.aids.replayed_starts.bank={bank}", *small],
-                10_000_000,
-                num_envs=128,
-                threads=1,
-            )
-            assert pinned.differences(as_trained) == {}
+            pin = [f"env.aids.replayed_starts.bank={bank}"]
+            as_trained = blind_baoding(robot, "baoding_cpu_shadow", [*pin, "network.encoder=[512, 256, 128]"])
+            assert blind_baoding(robot, "baoding_cpu", pin).differences(as_trained) == {}
     study = plan_named("round_bank")
+    swinging = {"env.aids.replayed_starts.bank": ("shadow_preswap", "shadow_round_preswap")}
     for cell in study.cells:
-        recipe = build_run_spec(
-            "baoding", cell.robot, "blind", "baoding_cpu", [], 1, num_envs=128, threads=1, seed=cell.seed
-        )
-        differences = cell_spec(study, cell).differences(recipe)
-        swinging = {"env.aids.replayed_starts.bank": ("shadow_preswap", "shadow_round_preswap")}
+        differences = cell_spec(study, cell).differences(blind_baoding(cell.robot, "baoding_cpu", seed=cell.seed))
         assert differences == ({} if cell.variant == "small_round_bank" else swinging)
     for name in ("every_hand", "small_net"):
         study = plan_named(name)
         for cell in study.cells:
-            before = build_run_spec(
-                "baoding",
-                cell.robot,
-                "blind",
-                "baoding_cpu",
-                [f"env.aids.replayed_starts.bank={cell.robot}_preswap"],
-                1,
-                num_envs=128,
-                threads=1,
-                seed=cell.seed,
+            pin = [f"env.aids.replayed_starts.bank={cell.robot}_preswap"]
+            assert (
+                cell_spec(study, cell).differences(blind_baoding(cell.robot, "baoding_cpu", pin, seed=cell.seed)) == {}
             )
-            assert cell_spec(study, cell).differences(before) == {}
 
 
-def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_swap():
-    """Their cells differ from baoding_cpu with the swinging bank, the recipe experiments/baoding_small_net
-    (seeds 0-4) and experiments/baoding_round_bank (seeds 5-9) trained on the same seeds, only by the
-    round-swaps aid with first_paid, so the two pair seed by seed."""
+@pytest.mark.parametrize(
+    "name, variant, seeds, pin",
+    [  # first_paid's pair baoding_cpu's runs from before its round bank; round_recipe's today's
+        ("first_paid", "first_paid", range(5), ["env.aids.replayed_starts.bank=shadow_preswap"]),
+        ("first_paid_untuned", "first_paid", range(5, 10), ["env.aids.replayed_starts.bank=shadow_preswap"]),
+        ("round_recipe", "round_first_paid", range(5), []),
+        ("round_recipe_untuned", "round_first_paid", range(5, 10), []),
+    ],
+)
+def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_swap(name, variant, seeds, pin):
+    """Their cells differ from the baoding_cpu runs they pair with seed by seed (experiments/
+    baoding_small_net and baoding_round_bank) only by the round-swaps aid with first_paid."""
     from roto.olympiad.cell import cell_spec
-    from roto.rl.run_spec import build_run_spec
 
-    for name, seeds in (("first_paid", range(5)), ("first_paid_untuned", range(5, 10))):
-        plan = plan_named(name)
-        assert [(c.robot, c.variant, c.seed) for c in plan.cells] == [("shadow", "first_paid", s) for s in seeds]
-        pin = ["env.aids.replayed_starts.bank=shadow_preswap"]  # baoding_cpu before its round bank
-        recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu", pin, plan.steps, num_envs=128, threads=1)
-        for cell in plan.cells:
-            differences = cell_spec(plan, cell).differences(recipe.with_seed(cell.seed))
-            assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True}, None)}
-
-
-def test_the_round_recipe_plans_are_baoding_cpu_with_round_swaps_paying_the_first_swap():
-    """experiments/baoding_round_recipe's cells differ from today's baoding_cpu (the round bank's
-    small_round_bank runs on seeds 0 and 5-9) only by the round-swaps aid with first_paid."""
-    from roto.olympiad.cell import cell_spec
-    from roto.rl.run_spec import build_run_spec
-
-    for name, seeds in (("round_recipe", range(5)), ("round_recipe_untuned", range(5, 10))):
-        plan = plan_named(name)
-        assert [(c.robot, c.variant, c.seed) for c in plan.cells] == [("shadow", "round_first_paid", s) for s in seeds]
-        recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu", [], plan.steps, num_envs=128, threads=1)
-        for cell in plan.cells:
-            differences = cell_spec(plan, cell).differences(recipe.with_seed(cell.seed))
-            assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True}, None)}
+    plan = plan_named(name)
+    assert [(c.robot, c.variant, c.seed) for c in plan.cells] == [("shadow", variant, s) for s in seeds]
+    for cell in plan.cells:
+        recipe = blind_baoding("shadow", "baoding_cpu", pin, plan.steps, seed=cell.seed)
+        differences = cell_spec(plan, cell).differences(recipe)
+        assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True}, None)}
