@@ -359,11 +359,11 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
         "orca_round_preswap",
     )
     expected = {
-        "round_swaps": {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False}, None)},
+        "round_swaps": {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False, "after": None}, None)},
         "round_bank": {"env.aids.replayed_starts.bank": (round_bank, bank)},
         "round_bank_round_swaps": {
             "env.aids.replayed_starts.bank": (round_bank, bank),
-            "env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False}, None),
+            "env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False, "after": None}, None),
         },
     }
     assert [(c.variant, c.seed) for c in plan.cells] == [
@@ -397,7 +397,7 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
     round_bank = "shadow_round_preswap"
     assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
         "env.aids.replayed_starts.bank": (round_bank, recipe.env.aids.replayed_starts.bank),
-        "env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False}, None),
+        "env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False, "after": None}, None),
         "env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None}),  # the recipe's since it ran
         "env.seed": (3, 0),
     }  # fmt: skip
@@ -483,17 +483,20 @@ def test_baoding_cpu_is_what_the_round_bank_study_trained_and_before_its_round_b
 
 
 @pytest.mark.parametrize(
-    "name, variant, seeds, pin",
-    [  # first_paid's pair baoding_cpu's runs from before its round bank; round_recipe's today's
-        ("first_paid", "first_paid", range(5), ["env.aids.replayed_starts.bank=shadow_preswap"]),
-        ("first_paid_untuned", "first_paid", range(5, 10), ["env.aids.replayed_starts.bank=shadow_preswap"]),
-        ("round_recipe", "round_first_paid", range(5), []),
-        ("round_recipe_untuned", "round_first_paid", range(5, 10), []),
+    "name, variant, seeds, pin, after",
+    [  # first_paid's pair baoding_cpu's runs from before its round bank; the others today's
+        ("first_paid", "first_paid", range(5), ["env.aids.replayed_starts.bank=shadow_preswap"], None),
+        ("first_paid_untuned", "first_paid", range(5, 10), ["env.aids.replayed_starts.bank=shadow_preswap"], None),
+        ("round_recipe", "round_first_paid", range(5), [], None),
+        ("round_recipe_untuned", "round_first_paid", range(5, 10), [], None),
+        ("armed", "armed_round", range(5), [], 2.0),
+        ("armed_untuned", "armed_round", range(5, 10), [], 2.0),
     ],
 )
-def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_swap(name, variant, seeds, pin):
+def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_swap(name, variant, seeds, pin, after):
     """Their cells differ from the baoding_cpu runs they pair with seed by seed (experiments/
-    baoding_small_net and baoding_round_bank) only by the round-swaps aid with first_paid."""
+    baoding_small_net and baoding_round_bank) only by the round-swaps aid with first_paid (armed
+    after 2 rotations in experiments/baoding_armed_round_swaps)."""
     from roto.olympiad.cell import cell_spec
 
     plan = plan_named(name)
@@ -501,4 +504,4 @@ def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_
     for cell in plan.cells:
         recipe = blind_baoding("shadow", "baoding_cpu", pin, plan.steps, seed=cell.seed)
         differences = cell_spec(plan, cell).differences(recipe)
-        assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True}, None)}
+        assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True, "after": after}, None)}

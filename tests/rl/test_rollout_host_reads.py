@@ -3,6 +3,7 @@ episode statistics), on Warp's CPU device: it reads nothing back from the device
 deliberate reads (the env's periodic checks, a training aid's state once per update). On a GPU,
 tests/rl/test_training_gpu.py checks the same under CUDA's sync-debug mode."""
 
+import pytest
 import torch
 
 from roto.envs.aids.event_recorder import RecordedEvents
@@ -13,8 +14,12 @@ from roto.rl.run_spec import RunSpec
 from roto.rl.runner import Trainer
 from tests.conftest import BAODING_AIDS, require_warp
 
+ARMED = {**BAODING_AIDS["aids"], "round_swaps": {"min_turn": 0.25, "first_paid": True, "after": 0.5}}
+"""The recipe's aids with round swaps armed part way (an aid that follows the ended episodes)."""
 
-def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch, host_reads):
+
+@pytest.mark.parametrize("aids", [BAODING_AIDS["aids"], ARMED], ids=["aids", "armed_round_swaps"])
+def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch, host_reads, aids):
     require_warp()
     env = EnvConfig(
         task="baoding",
@@ -24,7 +29,7 @@ def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch,
         device="cpu",
         seed=0,
         episode_steps=60,
-        **BAODING_AIDS,
+        aids=aids,
     )
     agent = load_agent_config(
         "baoding_cpu_shadow", overrides=["ppo.rollouts=8", "run.eval_every=100", "run.num_eval_envs=2"]

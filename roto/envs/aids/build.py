@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from roto.envs.aids.protocol import AidHost, TrainingAid
 from roto.envs.aids.replayed_starts import ReplayedStarts
-from roto.envs.aids.round_swaps import RoundSwaps
+from roto.envs.aids.round_swaps import ArmedRoundSwaps, RoundSwaps
 from roto.envs.aids.tolerance import ToleranceAid
 from roto.envs.aids.turn_shaping import TurnShaping
 
@@ -12,7 +12,7 @@ from roto.envs.aids.turn_shaping import TurnShaping
 def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
     """The aids ``host.config.aids`` switches on (none for an evaluation env): replayed starts,
     with the recorder of the envs' own events beside them when ``record_lead`` > 0, the tolerance
-    curriculum, round swaps, turn shaping."""
+    curriculum, round swaps (armed part way with ``after``), turn shaping."""
     section, aids = host.config.aids, []
     if section.replayed_starts is not None:
         replay = ReplayedStarts(host, section.replayed_starts)
@@ -22,7 +22,8 @@ def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
     if section.tolerance is not None:
         aids.append(ToleranceAid(host, section.tolerance))
     if section.round_swaps is not None:
-        aids.append(RoundSwaps(host, section.round_swaps))
+        armed = section.round_swaps.after is not None
+        aids.append((ArmedRoundSwaps if armed else RoundSwaps)(host, section.round_swaps))
     if section.turn_shaping is not None:
         aids.append(TurnShaping(host, section.turn_shaping))
     return tuple(aids)

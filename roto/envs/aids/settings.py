@@ -106,16 +106,22 @@ class RoundSwapsSettings:
         first_paid: an episode's first swap is paid however little the pair turned before it (its
             way round becomes the episode's): a replayed start, a few control steps before a swap,
             keeps its swap's reward, which ``min_turn`` alone would withhold.
+        after: None: from the first step; else every swap is paid until the training episodes
+            reach this many rotations (the running mean over ended episodes the tolerance
+            curriculum also follows), and ``min_turn`` holds from then on, even if they fall back.
     """
 
     min_turn: float = 0.25
     first_paid: bool = False
+    after: float | None = None
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "swap_min_turn", "swaps")
         _number(f"{path}.min_turn", self.min_turn, 0.0, 0.5, "a number of turns")
         if not isinstance(self.first_paid, bool):
             raise ValueError(f"{path}.first_paid must be true or false, got {self.first_paid!r}")
+        if self.after is not None:
+            _number(f"{path}.after", self.after, 1e-9, 1e6, "rotations per episode (or null: from the start)")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -1,11 +1,11 @@
 """A training-only tolerance curriculum: the task's success radius starts wide and narrows to the
 benchmark's as the training episodes succeed.
 
-For a task with a success radius (Baoding's latch radius, the task parameter ``success_radius``): the radius is
-``end + (start - end) * max(0, 1 - mean / target)``, where ``mean`` is a running mean of the headline
-metric (Baoding: rotations) over the training episodes that ended so far (each ended episode
-weighs ``EPISODE_WEIGHT``), ``start`` is ``ToleranceSettings.start`` and ``end`` the task's own
-radius. So the radius is ``start`` while no episode succeeds, the task's own once the episodes
+For a task with a success radius (Baoding's latch radius, the task parameter ``success_radius``):
+the radius is ``end + (start - end) * max(0, 1 - mean / target)``, where ``mean`` is the running
+mean of the headline metric (Baoding: rotations) over the training episodes that ended so far
+(``roto.envs.aids.episode_mean``), ``start`` is ``ToleranceSettings.start`` and ``end`` the task's
+own radius. So the radius is ``start`` while no episode succeeds, the task's own once the episodes
 reach ``ToleranceSettings.target`` on average, and widens again if they fall back. The update
 runs on the env's device in fixed shapes, never reading it. Evaluation envs never use it
 (``EnvConfig.without_training_aids``).
@@ -17,11 +17,9 @@ from dataclasses import dataclass
 
 import torch
 
+from roto.envs.aids.episode_mean import fold_ended_episodes
 from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
 from roto.envs.aids.settings import ToleranceSettings
-
-EPISODE_WEIGHT = 0.01
-"""Weight of one ended episode in the running mean (about the last hundred episodes count)."""
 
 
 @dataclass
@@ -41,13 +39,8 @@ class ToleranceCurriculum:
 
     def update(self, metric: torch.Tensor, done: torch.Tensor) -> torch.Tensor:
         """Fold in the episodes that end now (``done`` (B,) bool, their headline ``metric`` (B,));
-        returns the new radius. k ended episodes move the mean as k updates of weight
-        ``EPISODE_WEIGHT`` towards their mean would."""
-        ended = done.to(torch.float64)
-        count = ended.sum()
-        batch_mean = (metric.to(torch.float64) * ended).sum() / torch.clamp(count, min=1.0)
-        weight = 1.0 - (1.0 - EPISODE_WEIGHT) ** count
-        self.mean = self.mean + weight * (batch_mean - self.mean)
+        returns the new radius (``fold_ended_episodes``)."""
+        self.mean = fold_ended_episodes(self.mean, metric, done)
         return self.radius()
 
     def state_dict(self) -> dict[str, object]:

@@ -5,8 +5,9 @@ import pytest
 import torch
 
 import roto
+from roto.envs.aids.episode_mean import EPISODE_WEIGHT
 from roto.envs.aids.protocol import StepContext
-from roto.envs.aids.tolerance import EPISODE_WEIGHT, ToleranceAid, ToleranceCurriculum
+from roto.envs.aids.tolerance import ToleranceAid, ToleranceCurriculum
 from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
 from roto.tasks.baoding import SUCCESS_RADIUS, baoding_rule
