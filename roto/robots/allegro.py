@@ -251,7 +251,7 @@ ALLEGRO = RobotSpec(
             "baoding": PairRecord(
                 reference=5.03,
                 warp_peaks=(24, 96),
-                recipe="baoding_cpu_allegro",
+                recipe="baoding_cpu",
                 geometry=BaodingGeometry(
                     ball_radius=_BAODING_RADIUS,
                     # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's Allegro variant, the

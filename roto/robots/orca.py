@@ -152,7 +152,7 @@ ORCA = RobotSpec(
             "baoding": PairRecord(
                 reference=5.78,
                 warp_peaks=(65, 277),
-                recipe="baoding_cpu_orca",
+                recipe="baoding_cpu",
                 geometry=BaodingGeometry(
                     ball_radius=_BAODING_RADIUS,
                     # T_palm: where the dropped ball a comes to rest (rest_after_drop); the stack δ·(1, 1, 1)

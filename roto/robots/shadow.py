@@ -133,7 +133,7 @@ SHADOW = RobotSpec(
             "baoding": PairRecord(
                 reference=7.31,
                 warp_peaks=(12, 65),
-                recipe="baoding_cpu_shadow",
+                recipe="baoding_cpu",
                 geometry=BaodingGeometry(
                     ball_radius=_BAODING_RADIUS,
                     # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack

@@ -174,7 +174,7 @@ SHADOW_LITE = RobotSpec(
             "baoding": PairRecord(
                 reference=5.5,
                 warp_peaks=(9, 48),
-                recipe="baoding_cpu_shadow_lite",
+                recipe="baoding_cpu",
                 geometry=BaodingGeometry(
                     ball_radius=_BAODING_RADIUS,
                     # T_palm: where the dropped ball a comes to rest (rest_after_drop); roto's stack

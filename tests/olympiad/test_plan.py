@@ -107,9 +107,10 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     (results / "bounce-shadow-blind-ppo-seed0.json").write_text(json.dumps(done))
     assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), "--results", str(results)]) == 0
     out = capsys.readouterr().out
-    assert "bounce-shadow-blind-ppo-seed0" in out and out.count(" done\n") == 1
-    # 35 cells left x 5 M steps at 5000 env steps/s = 35000 s
-    assert "1 done, 35 left; time left: 9.7 h for one worker at 5000 env steps/s" in out
+    assert "bounce-shadow-blind-ppo-seed0" in out and out.count(" done [5 M]\n") == 1
+    # 79 cells left: 34 of Bounce and 11 of Shadow Baoding at 5 M, 33 of the other hands' Baoding
+    # at 10 M: 560 M steps at 5000 env steps/s = 112000 s
+    assert "1 done, 79 left; time left: 31.1 h for one worker at 5000 env steps/s" in out
     assert not (tmp_path / "benchmark").exists()  # a dry run creates no study
     started = tmp_path / "benchmark" / "bounce-allegro-blind-ppo-seed0"  # a cell's run, 2.5 M steps in
     started.mkdir(parents=True)
@@ -120,11 +121,12 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     out = capsys.readouterr().out
     assert "bounce-allegro-blind-ppo-seed0" in out
     assert "(2.5 M env steps; last evaluation 27.25 bounces, best 31.50 at 1.2 M)" in out
-    assert "time left: 9.6 h for one worker" in out  # (175 M - 2.5 M) / 5000 env steps/s = 34500 s
+    assert "time left: 31.0 h for one worker" in out  # (560 M - 2.5 M) / 5000 env steps/s = 111500 s
     assert main(["olympiad", "benchmark", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
                  str(results)]) == 0  # fmt: skip
-    # 34 cells of 5 M and one of 2.5 M over two workers: 87.5 M on the busier one = 17500 s
-    assert "with 2 workers at 5000 env steps/s each (the finished cells' throughput): 4.9 h" in capsys.readouterr().out
+    # largest first over two workers: the 10 M cells 170 M and 160 M, the 5 M ones 110 M and 115 M,
+    # the 2.5 M one to the second: 280 M on the busier one = 56000 s
+    assert "with 2 workers at 5000 env steps/s each (the finished cells' throughput): 15.6 h" in capsys.readouterr().out
     assert sorted(p.name for p in (tmp_path / "benchmark").iterdir()) == [started.name]  # still no study
     none = ["--results", str(tmp_path / "none")]
     assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), *none]) == 0
@@ -132,14 +134,14 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     timed = [{**r, "train_wall_s": r["env_steps"] / 2500} for r in rounds]  # 2500 env steps/s between its rounds
     (started / "evaluations.jsonl").write_text("".join(json.dumps(r) + "\n" for r in timed))
     assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), *none]) == 0
-    # no finished cell: the started cell's throughput, (180 M - 2.5 M) / 2500 env steps/s = 71000 s
-    assert "time left: 19.7 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
+    # no finished cell: the started cell's throughput, (565 M - 2.5 M) / 2500 env steps/s = 225000 s
+    assert "time left: 62.5 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
         capsys.readouterr().out
     )
     assert main(["olympiad", "benchmark", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
                  str(tmp_path / "none")]) == 0  # fmt: skip
-    # 35 cells of 5 M and one of 2.5 M over two workers: 90 M on the busier one = 36000 s
-    assert "with 2 workers at 2500 env steps/s each (the started cells' last evaluation rounds): 10.0 h" in (
+    # the 10 M cells 170 M and 160 M, the 46 of 5 M 110 M and 120 M, the 2.5 M one: 282.5 M = 113000 s
+    assert "with 2 workers at 2500 env steps/s each (the started cells' last evaluation rounds): 31.4 h" in (
         capsys.readouterr().out
     )
 
@@ -252,25 +254,25 @@ def test_the_low_noise_variant_differs_from_all_three_only_in_the_policy_std():
     }
 
 
-@pytest.mark.parametrize(
-    ("plan_name", "robot", "variant"),
-    [
-        ("turn_shaping", "shadow", "recipe_turn20"),
-        ("baoding_v1_cpu", "shadow_lite", "task_critic_more_aids"),
-        ("baoding_v1_cpu", "allegro", "task_critic_more_aids"),
-        ("baoding_v1_cpu", "orca", "task_critic_more_aids_low_noise"),
-    ],
-)
-def test_each_hands_packaged_baoding_config_trains_as_its_olympiad_cell(plan_name, robot, variant):
-    """``roto train --agent_cfg baoding_cpu_<hand>`` is the recipe behind the hand's Baoding result."""
-    from roto.olympiad.cell import cell_spec
+@pytest.mark.parametrize("robot", sorted(ROBOTS))
+def test_every_hands_baoding_record_names_baoding_cpu_whose_only_hand_part_is_the_hands_own_bank(robot):
+    """One Baoding recipe for every hand: the record of each pair names ``baoding_cpu``, and a hand's
+    run differs from the Shadow's only in the hand and the bank of its own round reference controller."""
     from roto.rl.run_spec import build_run_spec
 
-    plan = plan_named(plan_name)
-    cell = cell_spec(plan, Cell("baoding", robot, "blind", variant, 0))
-    config = ROBOTS[robot].tasks["baoding"].recipe
-    packaged = build_run_spec("baoding", robot, "blind", config, [], plan.steps, num_envs=128, threads=1)
-    assert packaged.differences(cell) == {} and packaged.env.aids.replayed_starts.bank == f"{robot}_preswap"
+    def blind(hand):
+        return build_run_spec("baoding", hand, "blind", ROBOTS[hand].tasks["baoding"].recipe, [], num_envs=128)
+
+    assert ROBOTS[robot].tasks["baoding"].recipe == "baoding_cpu"
+    expected = (
+        {}
+        if robot == "shadow"
+        else {
+            "env.robot": (robot, "shadow"),
+            "env.aids.replayed_starts.bank": (f"{robot}_round_preswap", "shadow_round_preswap"),
+        }
+    )
+    assert blind(robot).differences(blind("shadow")) == expected
 
 
 def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_to_its_own():
@@ -436,14 +438,26 @@ def test_the_dry_run_line_shows_the_last_evaluations_path_metrics_where_it_has_t
     )
 
 
-def test_the_benchmark_plan_trains_every_hand_and_mode_with_its_record_s_recipe_on_three_seeds():
+def test_the_benchmark_plan_trains_every_hand_and_mode_with_its_record_s_recipe():
+    """Bounce: every hand and mode on seeds 0-2 (the cpu plan's cells where it had them); Baoding:
+    blind on seeds 0-4, state and proprio on 0-2, 5 M env steps on the Shadow and 10 M on the others."""
     from roto.olympiad.cell import cell_spec
 
     plan, cpu = load_plan("benchmark"), plan_named("cpu")
-    assert {(c.robot, c.obs, c.seed) for c in plan.cells} == {
-        (robot, obs, seed) for robot in ROBOTS for obs in ("blind", "state", "proprio") for seed in (0, 1, 2)
+    modes = ("blind", "state", "proprio")
+    assert {(c.robot, c.obs, c.seed) for c in plan.cells if c.task == "bounce"} == {
+        (robot, obs, seed) for robot in ROBOTS for obs in modes for seed in (0, 1, 2)
     }
-    shared = [c for c in plan.cells if c in set(cpu.cells)]  # the cpu plan's Bounce cells, same names
+    baoding = {(c.robot, c.obs, c.seed): plan.steps_for(c) for c in plan.cells if c.task == "baoding"}
+    assert baoding == {
+        (robot, obs, seed): 5_000_000 if robot == "shadow" else 10_000_000
+        for robot in ROBOTS
+        for obs in modes
+        for seed in ((0, 1, 2, 3, 4) if obs == "blind" else (0, 1, 2))
+    }
+    for cell in plan.cells:
+        assert plan.variants["ppo"].agent_for(cell.task, cell.robot)[0] == ROBOTS[cell.robot].tasks[cell.task].recipe
+    shared = [c for c in plan.cells if c in set(cpu.cells) and c.task == "bounce"]  # the cpu plan's, same names
     assert len(shared) == 24 and all(cell_spec(plan, c).differences(cell_spec(cpu, c)) == {} for c in shared)
 
 
