@@ -3,7 +3,7 @@
 # 8192 envs: the graphed rollout's GPU tests; simulation alone (a `roto bench` of bounce:shadow);
 # `bounce_gpu` trained for SPEED_S seconds without and then with the graphed rollout (compare
 # perf/inference_s, perf/simulation_s and perf/steps_per_s in their scalars.csv); then the Shadow's
-# Baoding recipe (baoding_cpu_shadow, graphed update, and the graphed rollout if its tests passed)
+# Baoding recipe (baoding_cpu, every hand's; graphed update, and the graphed rollout if its tests passed)
 # for the time left, seed 0.
 #   usage (on the GPU machine, in the repo root, after `bash benchmarks/gpu_machine.sh install ...`
 #   and `export PYTHONPATH=/tmp/site:$PWD ROTO_WARP_CACHE=/tmp/wc`):
@@ -27,5 +27,5 @@ if [ "$tests" -eq 0 ]; then
   PAIRS="" bash benchmarks/gpu_suite.sh "$out/graphed" "$speed_s" 8192 --agent_cfg bounce_gpu ppo.cuda_graph_rollout=true
 fi
 DEADLINE=$deadline PAIRS="" TRAIN_TASK=baoding TRAIN_ROBOT=shadow bash benchmarks/gpu_suite.sh "$out/baoding" 600 8192 \
-  --agent_cfg baoding_cpu_shadow ppo.cuda_graph=true "$rollout" run.eval_every=10 run.checkpoint_every=20
+  --agent_cfg baoding_cpu ppo.cuda_graph=true "$rollout" run.eval_every=10 run.checkpoint_every=20
 echo "sitting: $(( $(date +%s) - t0 )) s" | tee -a "$out/sitting.log"
