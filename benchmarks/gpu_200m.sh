@@ -33,7 +33,7 @@ log "bounce done"
 if [ $(( deadline - $(date +%s) )) -gt 150 ]; then
   DEADLINE=$(( deadline + 35 )) PAIRS="" SCALING="" PYTEST_FILES="" UPDATE_AGENTS="" TRAIN_TASK=baoding \
     TRAIN_ROBOT=shadow bash benchmarks/gpu_suite.sh "$out/baoding_round" 600 8192 \
-    --agent_cfg baoding_cpu_shadow_round ppo.cuda_graph=true ppo.tf32_update=true \
+    --agent_cfg experiments/baoding_configs/baoding_cpu_shadow_round.yaml ppo.cuda_graph=true ppo.tf32_update=true \
     run.eval_every=20 run.checkpoint_every=40
   log "baoding done"
 fi

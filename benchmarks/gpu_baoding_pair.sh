@@ -19,7 +19,7 @@ PAIRS=baoding:shadow bash benchmarks/gpu_suite.sh "$out/bench" 0 8192
 half=$(( (deadline - $(date +%s)) / 2 ))
 every=(run.eval_every=10 run.checkpoint_every=20)
 DEADLINE=$(( $(date +%s) + half )) PAIRS="" bash benchmarks/gpu_suite.sh "$out/recipe" 600 8192 \
-  --agent_cfg baoding_cpu_shadow ppo.cuda_graph=true "${every[@]}"
+  --agent_cfg experiments/baoding_configs/baoding_cpu_shadow.yaml ppo.cuda_graph=true "${every[@]}"
 DEADLINE=$deadline PAIRS="" bash benchmarks/gpu_suite.sh "$out/roto" 600 8192 \
   --agent_cfg baoding ppo.cuda_graph=true "${every[@]}"
 echo "baoding pair: $(( $(date +%s) - t0 )) s"

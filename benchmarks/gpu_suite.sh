@@ -13,7 +13,7 @@
 #                     seconds (scalars.csv: perf/steps_per_s; evaluations.jsonl: the evaluation curve),
 #                     with policy_best.pt / policy_latest.pt (weights and settings only, for `roto eval`
 #                     and `roto play` elsewhere); TRAIN_OVERRIDES go to `roto train` (ppo.cuda_graph=true,
-#                     --agent_cfg baoding_cpu_shadow)
+#                     --agent_cfg experiments/baoding_configs/baoding_cpu_shadow.yaml)
 #   suite.log         one line per step: exit status and seconds
 # A short lease runs a subset, chosen by environment variables (defaults: everything):
 #   PAIRS="bounce:shadow"        the (task:robot) pairs benched (default all eight)

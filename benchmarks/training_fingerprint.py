@@ -24,9 +24,9 @@ from roto.rl.run_spec import build_run_spec
 from roto.rl.runner import Trainer
 
 CASES = {
-    "shadow_all_aids": ("baoding", "shadow", "baoding_cpu_shadow"),
-    "orca_round": ("baoding", "orca", "baoding_cpu_orca_round"),
-    "lite": ("baoding", "shadow_lite", "baoding_cpu_shadow_lite"),
+    "shadow_all_aids": ("baoding", "shadow", "experiments/baoding_configs/baoding_cpu_shadow.yaml"),
+    "orca_round": ("baoding", "orca", "experiments/baoding_configs/baoding_cpu_orca_round.yaml"),
+    "lite": ("baoding", "shadow_lite", "experiments/baoding_configs/baoding_cpu_shadow_lite.yaml"),
     "bounce_quick": ("bounce", "shadow", "bounce_cpu_quickstart"),
 }
 SMALL = [

@@ -20,7 +20,8 @@ BAODING_AIDS = {
         "turn_shaping": {"per_turn": 20.0},
     }
 }
-"""Every training aid of the Baoding recipes at once (baoding_cpu_shadow, baoding_cpu_orca_round)."""
+"""Every training aid of the Baoding recipes at once (baoding_cpu, and the round swaps of
+experiments/baoding_configs/baoding_cpu_orca_round.yaml)."""
 
 HOST_READS = ("aten._local_scalar_dense", "aten.nonzero", "aten.masked_select", "aten.unique", "aten._unique2")
 """Ops that read a tensor's values back to the host (``.item()``, ``bool()``, indexing by a 0-d tensor,

@@ -11,7 +11,18 @@ from roto.robots import ROBOTS
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
-EXPERIMENT_PLANS = {path.stem: path for path in (ROOT / "experiments").glob("*/*.yaml")}
+EARLIER_CONFIGS = ROOT / "experiments" / "baoding_configs"
+"""The earlier per-hand Baoding agent configs (not plans), kept for the experiments that trained them."""
+EXPERIMENT_PLANS = {
+    path.stem: path for path in (ROOT / "experiments").glob("*/*.yaml") if path.parent != EARLIER_CONFIGS
+}
+
+
+def earlier(hand: str) -> str:
+    """The path of the earlier Baoding config ``baoding_cpu_<hand>`` (``orca_round``: ORCA's round one)."""
+    return str(EARLIER_CONFIGS / f"baoding_cpu_{hand}.yaml")
+
+
 """The plans roto's experiments ran (experiments/<study>/<plan>.yaml), by name."""
 
 
@@ -349,13 +360,13 @@ def test_the_cycle_variant_differs_from_the_low_noise_one_only_in_its_bank_of_st
 
 
 def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
-    """Each cell is ORCA's packaged recipe with the round-swap aid, the round controller's bank, or both
-    (on two seeds); the 20 M plan continues the cells with both, which ``baoding_cpu_orca_round`` packages."""
+    """Each cell is ORCA's earlier recipe with the round-swap aid, the round controller's bank, or both
+    (on two seeds); the 20 M plan continues the cells with both, which ``baoding_cpu_orca_round`` is."""
     from roto.olympiad.cell import cell_spec
     from roto.rl.run_spec import build_run_spec
 
     plan = plan_named("baoding_v1_round")
-    recipe = build_run_spec("baoding", "orca", "blind", "baoding_cpu_orca", [], plan.steps, num_envs=128, threads=1)
+    recipe = build_run_spec("baoding", "orca", "blind", earlier("orca"), [], plan.steps, num_envs=128, threads=1)
     bank, round_bank = (
         recipe.env.aids.replayed_starts.bank,
         "orca_round_preswap",
@@ -384,7 +395,7 @@ def test_the_round_plan_changes_orcas_recipe_only_in_what_it_names():
     for cell in long.cells:  # training the same (the budget aside), so each 5 M run continues
         assert cell_spec(long, cell).differences(cell_spec(plan, cell)) == {}
     packaged = build_run_spec(
-        "baoding", "orca", "blind", "baoding_cpu_orca_round", [], plan.steps, num_envs=128, threads=1
+        "baoding", "orca", "blind", earlier("orca_round"), [], plan.steps, num_envs=128, threads=1
     )
     assert packaged.differences(cell_spec(plan, Cell("baoding", "orca", "blind", "round_bank_round_swaps", 0))) == {}
 
@@ -395,7 +406,7 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
 
     plan = plan_named("baoding_v1_shadow_round")
     assert [c.name for c in plan.cells] == ["baoding-shadow-blind-round-seed3"] and plan.steps == 5_000_000
-    recipe = build_run_spec("baoding", "shadow", "blind", "baoding_cpu_shadow", [], plan.steps, num_envs=128, threads=1)
+    recipe = build_run_spec("baoding", "shadow", "blind", earlier("shadow"), [], plan.steps, num_envs=128, threads=1)
     round_bank = "shadow_round_preswap"
     assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
         "env.aids.replayed_starts.bank": (round_bank, recipe.env.aids.replayed_starts.bank),
@@ -471,7 +482,7 @@ def blind_baoding(robot: str, config: str, overrides: list[str] = (), steps: int
 def test_baoding_cpu_is_what_the_round_bank_study_trained_and_before_its_round_bank_what_the_others_did():
     """The packaged one-for-every-hand recipe is, on each hand, the Shadow's recipe with the hand's
     round bank and the smaller encoder: what experiments/baoding_round_bank trained as
-    small_round_bank (as overrides of baoding_cpu_shadow), so its results are baoding_cpu's. With the
+    small_round_bank (as overrides of the earlier baoding_cpu_shadow), so its results are baoding_cpu's. With the
     hand's swinging bank pinned, it is what the every-hand pilot, the small-net study and the round
     bank's paired baseline trained (baoding_cpu before that study's decision)."""
     from roto.olympiad.cell import cell_spec
@@ -480,7 +491,7 @@ def test_baoding_cpu_is_what_the_round_bank_study_trained_and_before_its_round_b
         assert blind_baoding(robot, "baoding_cpu").env.aids.replayed_starts.bank == f"{robot}_round_preswap"
         for bank in (f"{robot}_round_preswap", f"{robot}_preswap"):
             pin = [f"env.aids.replayed_starts.bank={bank}"]
-            as_trained = blind_baoding(robot, "baoding_cpu_shadow", [*pin, "network.encoder=[512, 256, 128]"])
+            as_trained = blind_baoding(robot, earlier("shadow"), [*pin, "network.encoder=[512, 256, 128]"])
             assert blind_baoding(robot, "baoding_cpu", pin).differences(as_trained) == {}
     study = plan_named("round_bank")
     swinging = {"env.aids.replayed_starts.bank": ("shadow_preswap", "shadow_round_preswap")}

@@ -31,9 +31,7 @@ def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch,
         episode_steps=60,
         aids=aids,
     )
-    agent = load_agent_config(
-        "baoding_cpu_shadow", overrides=["ppo.rollouts=8", "run.eval_every=100", "run.num_eval_envs=2"]
-    )
+    agent = load_agent_config("baoding_cpu", overrides=["ppo.rollouts=8", "run.eval_every=100", "run.num_eval_envs=2"])
     spec = RunSpec(env=env, agent=agent, steps=3 * agent.ppo.rollouts * env.num_envs)
     trainer = Trainer(spec, tmp_path / "run", tensorboard=False)
     trainer.env.checks.go_sync_free(4)  # as on a GPU

@@ -51,7 +51,7 @@ def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_
     with pytest.raises(ValueError, match=r"\['replay_share'\] are now set per aid, as \['replayed_starts.share'\]"):
         build_run_spec("baoding", "allegro", "blind", str(base))
     with pytest.raises(ValueError, match=r"env.replay_share=0.5.*set per aid now: env.aids.replayed_starts.share="):
-        build_run_spec("baoding", "allegro", "blind", "baoding_cpu_shadow", ["env.replay_share=0.5"])
+        build_run_spec("baoding", "allegro", "blind", "baoding_cpu", ["env.replay_share=0.5"])
 
 
 @pytest.mark.parametrize(

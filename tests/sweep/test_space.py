@@ -36,7 +36,7 @@ def test_packaged_spaces_are_roto2_roto1_cpu_quickstart_and_baoding_cpu_and_load
         ValueError, match=r"aids.replayed_starts needs \['bank'\], got \{'share': 0\.1\}"
     ):  # the bank is the study's to set
         load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), "baoding_cpu_v1")
-    for recipe_cfg in ("baoding_cpu", "baoding_cpu_shadow"):  # each with its own bank
+    for recipe_cfg in ("baoding_cpu", "experiments/baoding_configs/baoding_cpu_shadow.yaml"):  # each its own bank
         recipe = load_space("baoding_cpu", EnvConfig(task="baoding", num_envs=8), recipe_cfg)
         assert [p.key for p in recipe.parameters] == [p.key for p in baoding.parameters]
 

@@ -222,14 +222,12 @@ def test_the_enqueued_base_has_the_training_aids_of_its_agent_config(tmp_path):
     from roto.sweep.space import load_space
     from roto.sweep.study import enqueue_base
 
-    settings = SweepSettings(study="aids", task="baoding", agent_cfg="baoding_cpu_shadow", space="baoding_cpu",
+    settings = SweepSettings(study="aids", task="baoding", agent_cfg="baoding_cpu", space="baoding_cpu",
                              objective="metric", trials=2, num_envs=8, root=str(tmp_path))  # fmt: skip
     study, _ = open_study(settings)
     space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
     inside, _ = enqueue_base(study, settings, space)
-    assert (
-        inside["env.aids.replayed_starts.share"] == 0.5 and inside["ppo.epochs"] == 4
-    )  # baoding_cpu_shadow's, not defaults
+    assert inside["env.aids.replayed_starts.share"] == 0.5 and inside["ppo.epochs"] == 4  # baoding_cpu's, not defaults
 
 
 def test_joining_a_study_with_other_settings_is_an_error(tmp_path):

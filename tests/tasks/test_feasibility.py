@@ -83,8 +83,7 @@ def test_scripted_policy_bounces_the_ball_over_8_seeds(name):
 def test_the_noise_each_hands_hold_pose_tolerates_follows_from_its_measured_hold_times():
     """From the committed measurement (64 episodes per hand and noise level): the largest action
     noise under which the hold keeps the balls half an episode on average. The Shadow's 0.25 is the
-    std its Baoding recipe trains with (roto/configs/baoding_cpu_shadow.yaml); experiments/
-    baoding_every_hand trains the Allegro with its own."""
+    std roto's Baoding recipe trains every hand with (roto/configs/baoding_cpu.yaml)."""
     rows = json.loads((ROOT / "benchmarks/results/baoding_reference/hold_noise.json").read_text())
     found = {robot: tolerated_noise(rows, robot) for robot in sorted(ROBOTS)}
     assert found == {"allegro": 0.15, "orca": 0.1, "shadow": 0.25, "shadow_lite": 0.25}
