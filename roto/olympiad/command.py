@@ -38,6 +38,14 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="list the cells, which are done, and the time left; train nothing",
     )
+    p.add_argument(
+        "--adopt",
+        nargs=2,
+        metavar=("PLAN", "RESULTS"),
+        default=None,
+        help="count the finished cells of another plan (its summaries in RESULTS) that train exactly "
+        "a cell of this one as that cell: copy them into --results, and exit; train nothing",
+    )
     p.set_defaults(func=cmd_olympiad)
     r = sub.add_parser("results", help="tables (markdown, CSV) and learning curves of an Olympiad's cells")
     r.add_argument(
@@ -80,6 +88,13 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
             raise ValueError(f"--threads must be >= 1, got {args.threads}")
         plan = dataclasses.replace(plan, threads=args.threads)
     results = _results_dir(args, plan.name)
+    if args.adopt:
+        from roto.olympiad.adopt import adopt_cells
+
+        source_plan, source_results = load_plan(args.adopt[0]), pathlib.Path(args.adopt[1])
+        adopted = adopt_cells(source_plan, source_results, plan, results)
+        print(json.dumps({"plan": plan.name, "adopted": adopted, "from": source_plan.name, "results": str(results)}))
+        return 0
     if args.dry_run:
         if args.workers < 1:
             raise ValueError(f"--workers must be >= 1, got {args.workers}")
