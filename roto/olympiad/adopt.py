@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import pathlib
 
-from roto.olympiad.cell import cell_spec, summary_path
+from roto.olympiad.cell import agent_record, cell_spec, summary_path
 from roto.olympiad.plan import Cell, Plan
 from roto.olympiad.results import read_summaries
 from roto.result_files import write_text_atomic
@@ -39,26 +39,29 @@ def adopt_cells(
 ) -> list[str]:
     """Copy each summary in ``source_results`` (cells of ``source_plan``) that is exactly a cell of
     ``target_plan`` into ``target_results`` under that cell's name, unless the cell is done there;
-    returns the target cells written. A summary of a variant ``source_plan`` does not have is
-    refused, naming it."""
+    returns the target cells written. A summary another plan trained, or of a variant
+    ``source_plan`` does not have, is refused, naming it."""
     written = []
     for summary in read_summaries(source_results):
-        if summary["variant"] not in source_plan.variants:
-            raise ValueError(
-                f"summary {summary['task']}-{summary['robot']}-{summary['obs']}-{summary['variant']}-"
-                f"seed{summary['seed']} in {str(source_results)!r}: plan {source_plan.name!r} has no variant "
-                f"{summary['variant']!r}; valid variants: {sorted(source_plan.variants)}"
-            )
         source = Cell(*(summary[key] for key in ("task", "robot", "obs", "variant", "seed")))
+        where = f"summary {source.name} in {str(source_results)!r}"
+        if summary["plan"] != source_plan.name:
+            raise ValueError(
+                f"{where} was trained by plan {summary['plan']!r}, not {source_plan.name!r}; give its plan"
+            )
+        if source.variant not in source_plan.variants:
+            raise ValueError(
+                f"{where}: plan {source_plan.name!r} has no variant {source.variant!r}; "
+                f"valid variants: {sorted(source_plan.variants)}"
+            )
         target = same_run(source_plan, source, target_plan)
         if target is None or summary_path(target_results, target).is_file():
             continue
-        entry = target_plan.variants[target.variant].for_task(target.task)
         adopted = {
             **summary,
             "variant": target.variant,
             "plan": target_plan.name,
-            "agent": {"label": entry.label, "roto_agent": entry.roto_agent},
+            "agent": agent_record(target_plan, target),
             "adopted_from": {"plan": source_plan.name, "cell": source.name, "agent": summary.get("agent")},
         }
         target_results.mkdir(parents=True, exist_ok=True)

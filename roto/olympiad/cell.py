@@ -98,6 +98,13 @@ def cell_spec(plan: Plan, cell: Cell) -> RunSpec:
     return spec.with_seed(cell.seed)
 
 
+def agent_record(plan: Plan, cell: Cell) -> dict[str, Any]:
+    """A summary's ``agent``: the label of the config the plan trains the cell with, and the roto
+    agent its variant declares itself to be (None)."""
+    entry = plan.variants[cell.variant].for_task(cell.task)
+    return {"label": entry.label, "roto_agent": entry.roto_agent}
+
+
 def run_cell(
     plan: Plan,
     cell: Cell,
@@ -114,13 +121,12 @@ def run_cell(
     best = copy.deepcopy(final)
     best.load_state_dict(load_checkpoint(RunDir(run_dir).checkpoint("best"))["model"])
     records = read_evaluations(run_dir)
-    entry = plan.variants[cell.variant].for_task(cell.task)
     summary = {
         **format_stamp("cell summary"),
         **{key: getattr(cell, key) for key in ("task", "robot", "obs", "variant", "seed")},
         "task_version": get_task(cell.task).version,
         "plan": plan.name,
-        "agent": {"label": entry.label, "roto_agent": entry.roto_agent},
+        "agent": agent_record(plan, cell),
         "training_aids": trainer.spec.env.aids.to_dict(),
         "commit": commit,
         "run_dir": str(run_dir),

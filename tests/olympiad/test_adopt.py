@@ -83,6 +83,15 @@ def test_a_summary_of_a_variant_the_plan_lacks_is_refused_naming_it(plans):
     assert not (tmp_path / "bench_results").exists()
 
 
+def test_a_summary_another_plan_trained_is_refused_naming_both_plans(plans):
+    """A folder given with the wrong plan would be judged by that plan's settings: refused."""
+    study, bench, tmp_path = plans
+    write_summary(tmp_path / "study_results", "armed", 0, "elsewhere", 1.0)
+    with pytest.raises(ValueError, match=r"armed-seed0 in .* was trained by plan 'elsewhere', not 'study'"):
+        adopt_cells(study, tmp_path / "study_results", bench, tmp_path / "bench_results")
+    assert not (tmp_path / "bench_results").exists()
+
+
 def test_the_olympiad_command_adopts_and_trains_nothing(plans, capsys):
     _, _, tmp_path = plans
     write_summary(tmp_path / "study_results", "armed", 0, "study", 12.5)

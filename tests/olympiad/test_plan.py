@@ -16,14 +16,12 @@ EARLIER_CONFIGS = ROOT / "experiments" / "baoding_configs"
 EXPERIMENT_PLANS = {
     path.stem: path for path in (ROOT / "experiments").glob("*/*.yaml") if path.parent != EARLIER_CONFIGS
 }
+"""The plans roto's experiments ran (experiments/<study>/<plan>.yaml), by name."""
 
 
 def earlier(hand: str) -> str:
     """The path of the earlier Baoding config ``baoding_cpu_<hand>`` (``orca_round``: ORCA's round one)."""
     return str(EARLIER_CONFIGS / f"baoding_cpu_{hand}.yaml")
-
-
-"""The plans roto's experiments ran (experiments/<study>/<plan>.yaml), by name."""
 
 
 def plan_named(name: str):
