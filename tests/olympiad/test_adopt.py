@@ -75,19 +75,18 @@ def test_a_cell_that_differs_in_any_setting_or_its_budget_is_not_adopted(plans, 
         assert not (tmp_path / f"{other.name}_results").exists()
 
 
-def test_a_summary_of_a_variant_the_plan_lacks_is_refused_naming_it(plans):
+@pytest.mark.parametrize(
+    ("variant", "trained_by", "message"),
+    [
+        ("elsewhere", "study", r"plan 'study' has no variant 'elsewhere'; valid variants: \['armed'\]"),
+        # a folder given with the wrong plan would be judged by that plan's settings
+        ("armed", "elsewhere", r"armed-seed0 in .* was trained by plan 'elsewhere', not 'study'"),
+    ],
+)
+def test_a_summary_of_another_plan_or_an_unknown_variant_is_refused_naming_it(plans, variant, trained_by, message):
     study, bench, tmp_path = plans
-    write_summary(tmp_path / "study_results", "elsewhere", 0, "study", 1.0)
-    with pytest.raises(ValueError, match=r"plan 'study' has no variant 'elsewhere'; valid variants: \['armed'\]"):
-        adopt_cells(study, tmp_path / "study_results", bench, tmp_path / "bench_results")
-    assert not (tmp_path / "bench_results").exists()
-
-
-def test_a_summary_another_plan_trained_is_refused_naming_both_plans(plans):
-    """A folder given with the wrong plan would be judged by that plan's settings: refused."""
-    study, bench, tmp_path = plans
-    write_summary(tmp_path / "study_results", "armed", 0, "elsewhere", 1.0)
-    with pytest.raises(ValueError, match=r"armed-seed0 in .* was trained by plan 'elsewhere', not 'study'"):
+    write_summary(tmp_path / "study_results", variant, 0, trained_by, 1.0)
+    with pytest.raises(ValueError, match=message):
         adopt_cells(study, tmp_path / "study_results", bench, tmp_path / "bench_results")
     assert not (tmp_path / "bench_results").exists()
 
