@@ -37,34 +37,42 @@ def same_run(source_plan: Plan, source: Cell, target_plan: Plan) -> Cell | None:
 def adopt_cells(
     source_plan: Plan, source_results: pathlib.Path, target_plan: Plan, target_results: pathlib.Path
 ) -> list[str]:
-    """Copy each summary in ``source_results`` (cells of ``source_plan``) that is exactly a cell of
-    ``target_plan`` into ``target_results`` under that cell's name, unless the cell is done there;
-    returns the target cells written. A summary another plan trained, or of a variant
-    ``source_plan`` does not have, is refused, naming it."""
-    written = []
-    for summary in read_summaries(source_results):
+    """Copy each summary in ``source_results`` that ``source_plan`` trained and that is exactly a cell
+    of ``target_plan`` into ``target_results`` under that cell's name, unless the cell is done there;
+    returns the target cells written. Summaries of other plans in the folder (a study's plans may
+    share one) are passed over; a folder none of whose summaries ``source_plan`` trained, or a
+    summary of a variant it does not have, is refused naming it, before anything is written."""
+    summaries = read_summaries(source_results)
+    own = [summary for summary in summaries if summary["plan"] == source_plan.name]
+    if summaries and not own:
+        raise ValueError(
+            f"no summary in {str(source_results)!r} was trained by plan {source_plan.name!r} (its "
+            f"summaries' plans: {sorted({summary['plan'] for summary in summaries})}); give their plan"
+        )
+    adoptions = []
+    for summary in own:
         source = Cell(*(summary[key] for key in ("task", "robot", "obs", "variant", "seed")))
-        where = f"summary {source.name} in {str(source_results)!r}"
-        if summary["plan"] != source_plan.name:
-            raise ValueError(
-                f"{where} was trained by plan {summary['plan']!r}, not {source_plan.name!r}; give its plan"
-            )
         if source.variant not in source_plan.variants:
             raise ValueError(
-                f"{where}: plan {source_plan.name!r} has no variant {source.variant!r}; "
-                f"valid variants: {sorted(source_plan.variants)}"
+                f"summary {source.name} in {str(source_results)!r}: plan {source_plan.name!r} has no variant "
+                f"{source.variant!r}; valid variants: {sorted(source_plan.variants)}"
             )
         target = same_run(source_plan, source, target_plan)
-        if target is None or summary_path(target_results, target).is_file():
-            continue
-        adopted = {
-            **summary,
-            "variant": target.variant,
-            "plan": target_plan.name,
-            "agent": agent_record(target_plan, target),
-            "adopted_from": {"plan": source_plan.name, "cell": source.name, "agent": summary.get("agent")},
-        }
+        if target is not None and not summary_path(target_results, target).is_file():
+            adoptions.append((target, adopted_summary(summary, source_plan, source, target_plan, target)))
+    for target, adopted in adoptions:
         target_results.mkdir(parents=True, exist_ok=True)
         write_text_atomic(summary_path(target_results, target), json.dumps(adopted, indent=1))
-        written.append(target.name)
-    return written
+    return [target.name for target, _ in adoptions]
+
+
+def adopted_summary(summary: dict, source_plan: Plan, source: Cell, target_plan: Plan, target: Cell) -> dict:
+    """``summary`` as ``target_plan`` would have written it for ``target``, with ``adopted_from``
+    naming the plan, cell and agent it was trained as; every measurement kept as it is."""
+    return {
+        **summary,
+        "variant": target.variant,
+        "plan": target_plan.name,
+        "agent": agent_record(target_plan, target),
+        "adopted_from": {"plan": source_plan.name, "cell": source.name, "agent": summary.get("agent")},
+    }

@@ -75,17 +75,38 @@ def test_a_cell_that_differs_in_any_setting_or_its_budget_is_not_adopted(plans, 
         assert not (tmp_path / f"{other.name}_results").exists()
 
 
+def test_a_study_folder_may_hold_another_plans_summaries_which_are_passed_over(plans):
+    study, bench, tmp_path = plans
+    write_summary(tmp_path / "study_results", "armed", 0, "study", 12.5)
+    write_summary(tmp_path / "study_results", "armed", 2, "untuned", 3.25)  # the same variant, another plan
+    assert adopt_cells(study, tmp_path / "study_results", bench, tmp_path / "bench_results") == [
+        "baoding-shadow-blind-ppo-seed0"
+    ]
+    assert sorted(path.name for path in (tmp_path / "bench_results").iterdir()) == [
+        "baoding-shadow-blind-ppo-seed0.json"
+    ]
+
+
 @pytest.mark.parametrize(
-    ("variant", "trained_by", "message"),
-    [
-        ("elsewhere", "study", r"plan 'study' has no variant 'elsewhere'; valid variants: \['armed'\]"),
+    ("summaries", "message"),
+    [  # an adoptable summary beside the bad one: nothing is written
+        (
+            [("armed", 0, "study"), ("elsewhere", 2, "study")],
+            r"plan 'study' has no variant 'elsewhere'; valid variants: \['armed'\]",
+        ),
         # a folder given with the wrong plan would be judged by that plan's settings
-        ("armed", "elsewhere", r"armed-seed0 in .* was trained by plan 'elsewhere', not 'study'"),
+        (
+            [("armed", 0, "elsewhere")],
+            r"no summary in .* was trained by plan 'study' \(its summaries' plans: \['elsewhere'\]\)",
+        ),
     ],
 )
-def test_a_summary_of_another_plan_or_an_unknown_variant_is_refused_naming_it(plans, variant, trained_by, message):
+def test_a_folder_of_another_plan_or_an_unknown_variant_is_refused_naming_it_and_nothing_is_written(
+    plans, summaries, message
+):
     study, bench, tmp_path = plans
-    write_summary(tmp_path / "study_results", variant, 0, trained_by, 1.0)
+    for variant, seed, trained_by in summaries:
+        write_summary(tmp_path / "study_results", variant, seed, trained_by, 1.0)
     with pytest.raises(ValueError, match=message):
         adopt_cells(study, tmp_path / "study_results", bench, tmp_path / "bench_results")
     assert not (tmp_path / "bench_results").exists()
