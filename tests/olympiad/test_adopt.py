@@ -11,6 +11,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 TEMPLATE = (
     ROOT / "experiments" / "baoding_armed_round_swaps" / "results" / "baoding-shadow-blind-armed_round-seed5.json"
 )
+HALF_TURN_SHAPING = "env.aids.turn_shaping.per_turn=10"
+"""A setting baoding_cpu does not have (it pays 20 per turn)."""
 
 
 def write_plan(path: pathlib.Path, variant: str, entry: str, seeds: str, steps: int = 40960) -> pathlib.Path:
@@ -31,14 +33,13 @@ def write_summary(folder: pathlib.Path, variant: str, seed: int, plan: str, rota
 
 @pytest.fixture
 def plans(tmp_path):
-    """A study that trains baoding_cpu with round swaps as an override, and a benchmark whose
-    config file is baoding_cpu with the same round swaps written in: the same runs, two names."""
-    config = tmp_path / "with_round_swaps.yaml"
-    config.write_text("extends: baoding_cpu\ntraining_aids:\n  round_swaps: {min_turn: 0.25}\n")
+    """A study that trains baoding_cpu with a halved turn shaping as an override, and a benchmark
+    whose config file is baoding_cpu with the same turn shaping written in: the same runs, two names."""
+    config = tmp_path / "half_turn_shaping.yaml"
+    config.write_text("extends: baoding_cpu\ntraining_aids:\n  turn_shaping: {per_turn: 10}\n")
     study = write_plan(
-        tmp_path / "study.yaml", "armed", "{agent_cfg: baoding_cpu, overrides: [env.aids.round_swaps.min_turn=0.25]}",
-        "[0, 2, 3]",
-    )  # fmt: skip
+        tmp_path / "study.yaml", "armed", f"{{agent_cfg: baoding_cpu, overrides: [{HALF_TURN_SHAPING}]}}", "[0, 2, 3]"
+    )
     bench = write_plan(tmp_path / "bench.yaml", "ppo", f"{{agent_cfg: {config}}}", "[0, 1, 2]")
     return load_plan(str(study)), load_plan(str(bench)), tmp_path
 
@@ -52,7 +53,7 @@ def test_a_study_cell_that_trains_exactly_a_benchmark_cell_counts_as_it_and_says
     assert adopt_cells(study, source, bench, target) == ["baoding-shadow-blind-ppo-seed0"]  # seed 3: no such cell
     adopted = json.loads((target / "baoding-shadow-blind-ppo-seed0.json").read_text())
     assert (adopted["variant"], adopted["plan"], adopted["best"]["round_rotations_mean"]) == ("ppo", "bench", 12.5)
-    assert adopted["agent"]["label"] == str(tmp_path / "with_round_swaps.yaml")
+    assert adopted["agent"]["label"] == str(tmp_path / "half_turn_shaping.yaml")
     assert adopted["adopted_from"]["plan"] == "study"
     assert adopted["adopted_from"]["cell"] == "baoding-shadow-blind-armed-seed0"
     assert (
@@ -67,9 +68,8 @@ def test_a_cell_that_differs_in_any_setting_or_its_budget_is_not_adopted(plans, 
     write_summary(source, "armed", 0, "study", 12.5)
     plain = load_plan(str(write_plan(tmp_path / "plain.yaml", "ppo", "{agent_cfg: baoding_cpu}", "[0]")))
     longer = write_plan(
-        tmp_path / "longer.yaml", "ppo", "{agent_cfg: baoding_cpu, overrides: [env.aids.round_swaps.min_turn=0.25]}",
-        "[0]", steps=81920,
-    )  # fmt: skip
+        tmp_path / "longer.yaml", "ppo", f"{{agent_cfg: baoding_cpu, overrides: [{HALF_TURN_SHAPING}]}}", "[0]", 81920
+    )
     for other in (plain, load_plan(str(longer))):
         assert adopt_cells(study, source, other, tmp_path / f"{other.name}_results") == []
         assert not (tmp_path / f"{other.name}_results").exists()

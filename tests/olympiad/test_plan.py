@@ -477,32 +477,70 @@ def blind_baoding(robot: str, config: str, overrides: list[str] = (), steps: int
     return build_run_spec("baoding", robot, "blind", config, list(overrides), steps, num_envs=128, threads=1, seed=seed)
 
 
-def test_baoding_cpu_is_what_the_round_bank_study_trained_and_before_its_round_bank_what_the_others_did():
-    """The packaged one-for-every-hand recipe is, on each hand, the Shadow's recipe with the hand's
-    round bank and the smaller encoder: what experiments/baoding_round_bank trained as
-    small_round_bank (as overrides of the earlier baoding_cpu_shadow), so its results are baoding_cpu's. With the
-    hand's swinging bank pinned, it is what the every-hand pilot, the small-net study and the round
-    bank's paired baseline trained (baoding_cpu before that study's decision)."""
+ROUND_BANK = earlier("round_bank")
+"""baoding_cpu as the round-bank and round-swaps studies trained it, before it took armed round swaps."""
+ARMED = ["env.aids.round_swaps={min_turn: 0.25, first_paid: true, after: 2}"]
+
+
+def test_baoding_cpu_is_its_round_bank_recipe_with_round_swaps_armed_as_the_armed_study_trained():
+    """The packaged one-for-every-hand recipe is, on each hand, the frozen round-bank recipe plus
+    round swaps armed after 2 rotations: what experiments/baoding_armed_round_swaps trained as
+    armed_round, so that study's results are baoding_cpu's."""
     from roto.olympiad.cell import cell_spec
 
     for robot in ROBOTS:
-        assert blind_baoding(robot, "baoding_cpu").env.aids.replayed_starts.bank == f"{robot}_round_preswap"
+        assert blind_baoding(robot, "baoding_cpu").differences(blind_baoding(robot, ROUND_BANK, ARMED)) == {}
+    for name in ("armed", "armed_untuned"):
+        study = plan_named(name)
+        for cell in study.cells:
+            assert cell_spec(study, cell).differences(blind_baoding(cell.robot, "baoding_cpu", seed=cell.seed)) == {}
+
+
+def test_the_round_bank_recipe_is_what_the_round_bank_study_trained_and_before_its_bank_what_the_others_did():
+    """The frozen round-bank recipe is, on each hand, the Shadow's earlier recipe with the hand's
+    round bank and the smaller encoder: what experiments/baoding_round_bank trained as
+    small_round_bank (as overrides of the earlier baoding_cpu_shadow). With the hand's swinging bank
+    pinned, it is what the every-hand pilot, the small-net study and the round bank's paired
+    baseline trained (baoding_cpu before that study's decision)."""
+    from roto.olympiad.cell import cell_spec
+
+    for robot in ROBOTS:
+        assert blind_baoding(robot, ROUND_BANK).env.aids.replayed_starts.bank == f"{robot}_round_preswap"
         for bank in (f"{robot}_round_preswap", f"{robot}_preswap"):
             pin = [f"env.aids.replayed_starts.bank={bank}"]
             as_trained = blind_baoding(robot, earlier("shadow"), [*pin, "network.encoder=[512, 256, 128]"])
-            assert blind_baoding(robot, "baoding_cpu", pin).differences(as_trained) == {}
+            assert blind_baoding(robot, ROUND_BANK, pin).differences(as_trained) == {}
     study = plan_named("round_bank")
     swinging = {"env.aids.replayed_starts.bank": ("shadow_preswap", "shadow_round_preswap")}
     for cell in study.cells:
-        differences = cell_spec(study, cell).differences(blind_baoding(cell.robot, "baoding_cpu", seed=cell.seed))
+        differences = cell_spec(study, cell).differences(blind_baoding(cell.robot, ROUND_BANK, seed=cell.seed))
         assert differences == ({} if cell.variant == "small_round_bank" else swinging)
     for name in ("every_hand", "small_net"):
         study = plan_named(name)
         for cell in study.cells:
             pin = [f"env.aids.replayed_starts.bank={cell.robot}_preswap"]
-            assert (
-                cell_spec(study, cell).differences(blind_baoding(cell.robot, "baoding_cpu", pin, seed=cell.seed)) == {}
-            )
+            assert cell_spec(study, cell).differences(blind_baoding(cell.robot, ROUND_BANK, pin, seed=cell.seed)) == {}
+
+
+def test_each_part_of_baoding_cpu_is_switched_off_by_exactly_one_ablation():
+    """experiments/baoding_ablations: every cell is baoding_cpu with one part off, one variant a part."""
+    from roto.olympiad.cell import cell_spec
+
+    plan = plan_named("ablations")
+    recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps)
+    replayed = {"bank": "shadow_round_preswap", "share": 0.5, "record_lead": 10, "record_capacity": 1024}
+    expected = {
+        "no_round_swaps": {"env.aids.round_swaps": (None, {"min_turn": 0.25, "first_paid": True, "after": 2})},
+        "no_turn_shaping": {"env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None})},
+        "no_replayed_starts": {"env.aids.replayed_starts": (None, replayed)},
+        "no_recording": {"env.aids.replayed_starts.record_lead": (0, 10)},
+        "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2})},
+        "std_1": {"agent.network.init_log_std": (0.0, -1.386), "agent.network.max_log_std": (0.0, -1.386)},
+        "plain_critic": {"agent.network.critic": (None, ["tactile", "proprio", "privileged", "task"])},
+    }
+    assert sorted({c.variant for c in plan.cells}) == sorted(expected) and {c.seed for c in plan.cells} == {0, 1, 2}
+    for cell in plan.cells:
+        assert cell_spec(plan, cell).differences(recipe.with_seed(cell.seed)) == expected[cell.variant], cell.variant
 
 
 @pytest.mark.parametrize(
@@ -525,6 +563,6 @@ def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_
     plan = plan_named(name)
     assert [(c.robot, c.variant, c.seed) for c in plan.cells] == [("shadow", variant, s) for s in seeds]
     for cell in plan.cells:
-        recipe = blind_baoding("shadow", "baoding_cpu", pin, plan.steps, seed=cell.seed)
+        recipe = blind_baoding("shadow", ROUND_BANK, pin, plan.steps, seed=cell.seed)
         differences = cell_spec(plan, cell).differences(recipe)
         assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True, "after": after}, None)}
