@@ -51,7 +51,7 @@ def adopt_cells(
         )
     adoptions = []
     for summary in own:
-        source = Cell(*(summary[key] for key in ("task", "robot", "obs", "variant", "seed")))
+        source = Cell.of_summary(summary)
         if source.variant not in source_plan.variants:
             raise ValueError(
                 f"summary {source.name} in {str(source_results)!r}: plan {source_plan.name!r} has no variant "
@@ -60,8 +60,9 @@ def adopt_cells(
         target = same_run(source_plan, source, target_plan)
         if target is not None and not summary_path(target_results, target).is_file():
             adoptions.append((target, adopted_summary(summary, source_plan, source, target_plan, target)))
-    for target, adopted in adoptions:
+    if adoptions:
         target_results.mkdir(parents=True, exist_ok=True)
+    for target, adopted in adoptions:
         write_text_atomic(summary_path(target_results, target), json.dumps(adopted, indent=1))
     return [target.name for target, _ in adoptions]
 

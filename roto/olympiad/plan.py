@@ -120,6 +120,11 @@ class Cell:
         """``<task>-<robot>-<obs>-<variant>-seed<k>``: the run directory's and the summary's name."""
         return f"{self.task}-{self.robot}-{self.obs}-{self.variant}-seed{self.seed}"
 
+    @classmethod
+    def of_summary(cls, summary: dict) -> Cell:
+        """The cell a cell summary (``roto.olympiad.cell.run_cell``'s) was trained as."""
+        return cls(*(summary[key] for key in ("task", "robot", "obs", "variant", "seed")))
+
 
 @dataclass(frozen=True)
 class Plan:

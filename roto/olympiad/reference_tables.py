@@ -74,7 +74,7 @@ def training_aids(summary: dict, plan: Plan | None = None) -> str:
     if "training_aids" in summary:
         names = sorted(summary["training_aids"])
     elif plan is not None and summary["variant"] in plan.variants:
-        cell = Cell(*(summary[key] for key in ("task", "robot", "obs", "variant", "seed")))
+        cell = Cell.of_summary(summary)
         names = sorted(cell_spec(plan, cell).env.aids.active())
     else:
         return "not recorded"
