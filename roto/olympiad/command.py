@@ -129,23 +129,6 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     return 0
 
 
-def busiest_worker_steps(steps_left: list[int], workers: int) -> int:
-    """Env steps of the busiest of ``workers`` workers when the cells go, largest first, each to the
-    least loaded worker (a cell is never split between workers)."""
-    loads = [0] * workers
-    for steps in sorted(steps_left, reverse=True):
-        loads[loads.index(min(loads))] += steps
-    return max(loads)
-
-
-def recent_rate(records: list[dict]) -> float | None:
-    """Training env steps per second between a run's last two evaluations (None without two)."""
-    if len(records) < 2 or "train_wall_s" not in records[-1] or "train_wall_s" not in records[-2]:
-        return None
-    seconds = records[-1]["train_wall_s"] - records[-2]["train_wall_s"]
-    return (records[-1]["env_steps"] - records[-2]["env_steps"]) / seconds if seconds > 0 else None
-
-
 def headline_so_far(records: list[dict], metric: str, path_metrics: tuple[str, ...] = ()) -> str:
     """``; last evaluation X <metric> (<other measure> P, ...), best Y at Z M`` from a run's
     evaluation records ("" without the metric; each other measure, ``path_metrics``, only where the
@@ -170,11 +153,9 @@ def status_metrics(task: Task, records: list[dict]) -> tuple[str, tuple[str, ...
 
 
 def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1) -> str:
-    """The cells and their status, and the time left at the throughput of the finished cells for
-    the env steps left (a started cell counts the env steps of its run's last evaluation), or, with
-    none finished, at the started cells' latest throughput; with several workers, also the time
-    until the busiest one is done, each at the running cells' current throughput."""
-    from roto.olympiad.results import read_summaries
+    """The cells and their status, and the time left for the env steps left (a started cell counts
+    the env steps of its run's last evaluation; ``time_left_estimate``)."""
+    from roto.olympiad.time_left import recent_rate
     from roto.olympiad.worker import cell_status
     from roto.rl.evaluation import read_evaluations
     from roto.tasks import get_task
@@ -185,42 +166,53 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
     uniform = len(set(budgets.values())) == 1
     each = f"{plan.steps} env steps each" if uniform else "env steps per cell as listed"
     lines = [f"plan {plan.name}: {len(plan.cells)} cells, {each}", ""]
-    done_steps, running_rates, started_rates = {}, [], []
+    done_steps, started_rates = {}, []
     for name, state in status.items():
         records = [] if state == "done" else read_evaluations(pathlib.Path(root) / plan.name / name)
         done_steps[name] = min(int(records[-1]["env_steps"]), budgets[name]) if records else 0
-        rate_now = recent_rate(records)
-        if rate_now:
+        if rate_now := recent_rate(records):
             started_rates.append(rate_now)
-            if state == "running":
-                running_rates.append(rate_now)
         so_far = headline_so_far(records, *status_metrics(tasks[name], records))
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps{so_far})" if records else ""
         budget = "" if uniform else f" [{budgets[name] / 1e6:g} M]"
         lines.append(f"  {name:<52} {state}{budget}{progress}")
     left = sum(state != "done" for state in status.values())
-    cells_left = [budgets[name] - done_steps[name] for name, state in status.items() if state != "done"]
+    steps_left = {name: budgets[name] - done_steps[name] for name, state in status.items() if state != "done"}
+    lines += ["", f"{len(status) - left} done, {left} left; time left: "]
+    lines[-1] += time_left_estimate(plan, results, steps_left, started_rates, workers)
+    return "\n".join(lines)
+
+
+def time_left_estimate(
+    plan: Plan, results: pathlib.Path, steps_left: dict[str, int], started_rates: list[float], workers: int
+) -> str:
+    """How long ``steps_left`` (env steps left per unfinished cell) takes: each cell at its task's
+    finished cells' throughput (the plan's summaries in ``results``), a task with none at all the
+    finished cells' throughput, or with none finished at the started cells' latest throughput; for
+    one worker, and with several, until the busiest one is done."""
+    from roto.olympiad.plan import Cell
+    from roto.olympiad.results import read_summaries
+    from roto.olympiad.time_left import busiest_worker_load, cell_seconds, rate_sources, task_throughputs
+
     try:
-        summaries = read_summaries(results)
+        summaries = [s for s in read_summaries(results) if Cell.of_summary(s) in set(plan.cells)]
     except FileNotFoundError:
         summaries = []
-    rate, source = None, ""
+    rates = task_throughputs(summaries)
     if summaries:
-        rate = sum(s["env_steps"] for s in summaries) / sum(s["train_wall_s"] for s in summaries)
-        source = "the finished cells' throughput"
+        fallback = sum(s["env_steps"] for s in summaries) / sum(s["train_wall_s"] for s in summaries)
+        source = "all the finished cells' throughput"
     elif started_rates:
-        rate, source = sum(started_rates) / len(started_rates), "the started cells' last evaluation rounds"
-    if rate:
-        estimate = f"{sum(cells_left) / rate / 3600:.1f} h for one worker at {rate:.0f} env steps/s ({source})"
+        fallback, source = sum(started_rates) / len(started_rates), "the started cells' last evaluation rounds"
     else:
-        estimate = f"unknown: no finished cell's summary in {results} (--results names the folder)"
-    lines += ["", f"{len(status) - left} done, {left} left; time left: {estimate}"]
-    if workers > 1 and (running_rates or rate):
-        each = sum(running_rates) / len(running_rates) if running_rates else rate
-        source = "the running cells' last evaluation rounds" if running_rates else source
-        hours = busiest_worker_steps(cells_left, workers) / each / 3600
-        lines.append(f"with {workers} workers at {each:.0f} env steps/s each ({source}): {hours:.1f} h")
-    return "\n".join(lines)
+        return f"unknown: no finished cell's summary in {results} (--results names the folder)"
+    task_of = {cell.name: cell.task for cell in plan.cells}
+    seconds = cell_seconds(steps_left, task_of, rates, fallback)
+    at = rate_sources(rates, (task_of[name] for name in steps_left), fallback, source)
+    estimate = f"{sum(seconds.values()) / 3600:.1f} h for one worker at {at}"
+    if workers > 1:
+        estimate += f"\nwith {workers} workers: {busiest_worker_load(seconds.values(), workers) / 3600:.1f} h"
+    return estimate
 
 
 def cmd_pages(pages: list[str]) -> int:

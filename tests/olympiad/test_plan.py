@@ -119,7 +119,8 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     assert "bounce-shadow-blind-ppo-seed0" in out and out.count(" done [5 M]\n") == 1
     # 79 cells left: 34 of Bounce and 11 of Shadow Baoding at 5 M, 33 of the other hands' Baoding
     # at 10 M: 560 M steps at 5000 env steps/s = 112000 s
-    assert "1 done, 79 left; time left: 31.1 h for one worker at 5000 env steps/s" in out
+    assert "1 done, 79 left; time left: 31.1 h for one worker at bounce 5000, baoding 5000 env steps/s" in out
+    assert "(the finished cells' throughput per task; baoding at all the finished cells' throughput)" in out
     assert not (tmp_path / "benchmark").exists()  # a dry run creates no study
     started = tmp_path / "benchmark" / "bounce-allegro-blind-ppo-seed0"  # a cell's run, 2.5 M steps in
     started.mkdir(parents=True)
@@ -135,7 +136,20 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
                  str(results)]) == 0  # fmt: skip
     # largest first over two workers: the 10 M cells 170 M and 160 M, the 5 M ones 110 M and 115 M,
     # the 2.5 M one to the second: 280 M on the busier one = 56000 s
-    assert "with 2 workers at 5000 env steps/s each (the finished cells' throughput): 15.6 h" in capsys.readouterr().out
+    assert "with 2 workers: 15.6 h" in capsys.readouterr().out
+    baoding = ROOT / "benchmarks" / "results" / "benchmark" / "cells" / "baoding-shadow-blind-ppo-seed0.json"
+    slower = {**json.loads(baoding.read_text()), "env_steps": 5_000_000, "train_wall_s": 2000.0}  # 2500 env steps/s
+    (results / baoding.name).write_text(json.dumps(slower))
+    (results / "baoding-shadow-blind-other-seed0.json").write_text(json.dumps({**slower, "variant": "other"}))
+    assert main(["olympiad", "benchmark", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
+                 str(results)]) == 0  # fmt: skip
+    out = capsys.readouterr().out  # each task at its own cells' rate; another plan's summary is not counted
+    # Bounce 172.5 M at 5000 env steps/s (34500 s), Baoding 380 M at 2500 (152000 s): 186500 s
+    assert "2 done, 78 left; time left: 51.8 h for one worker at bounce 5000, baoding 2500 env steps/s" in out
+    assert "(the finished cells' throughput per task)" in out
+    # two workers, largest first: the 10 M cells (4000 s) 17 and 16, the Shadow's (2000 s) 4 and 6,
+    # Bounce (1000 s) 17 and 17, the started one (500 s) to the first: 93500 s on the busier one
+    assert "with 2 workers: 26.0 h" in out
     assert sorted(p.name for p in (tmp_path / "benchmark").iterdir()) == [started.name]  # still no study
     none = ["--results", str(tmp_path / "none")]
     assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), *none]) == 0
@@ -144,15 +158,13 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     (started / "evaluations.jsonl").write_text("".join(json.dumps(r) + "\n" for r in timed))
     assert main(["olympiad", "benchmark", "--dry-run", "--root", str(tmp_path), *none]) == 0
     # no finished cell: the started cell's throughput, (565 M - 2.5 M) / 2500 env steps/s = 225000 s
-    assert "time left: 62.5 h for one worker at 2500 env steps/s (the started cells' last evaluation rounds)" in (
+    assert "time left: 62.5 h for one worker at bounce 2500, baoding 2500 env steps/s (the started cells' last" in (
         capsys.readouterr().out
     )
     assert main(["olympiad", "benchmark", "--dry-run", "--workers", "2", "--root", str(tmp_path), "--results",
                  str(tmp_path / "none")]) == 0  # fmt: skip
     # the 10 M cells 170 M and 160 M, the 46 of 5 M 110 M and 120 M, the 2.5 M one: 282.5 M = 113000 s
-    assert "with 2 workers at 2500 env steps/s each (the started cells' last evaluation rounds): 31.4 h" in (
-        capsys.readouterr().out
-    )
+    assert "with 2 workers: 31.4 h" in (capsys.readouterr().out)
 
 
 def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():
@@ -413,17 +425,6 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
         "env.seed": (3, 0),
     }  # fmt: skip
     assert round_bank in packaged_banks()
-
-
-def test_the_busiest_worker_and_a_running_cells_rate():
-    from roto.olympiad.command import busiest_worker_steps, recent_rate
-
-    assert busiest_worker_steps([5, 5, 5], 2) == 10  # cells are never split
-    assert busiest_worker_steps([7, 4, 3, 3], 2) == 10  # largest first: 7+3 and 4+3
-    assert busiest_worker_steps([4], 3) == 4
-    records = [{"env_steps": 1000, "train_wall_s": 10.0}, {"env_steps": 4000, "train_wall_s": 12.0}]
-    assert recent_rate(records) == 1500.0
-    assert recent_rate(records[:1]) is None and recent_rate([{"env_steps": 1}, {"env_steps": 2}]) is None
 
 
 def test_the_dry_run_line_shows_the_last_evaluations_path_metrics_where_it_has_them():
