@@ -192,16 +192,16 @@ def time_left_estimate(
     one worker, and with several, until the busiest one is done."""
     from roto.olympiad.plan import Cell
     from roto.olympiad.results import read_summaries
-    from roto.olympiad.time_left import busiest_worker_load, cell_seconds, rate_sources, task_throughputs
+    from roto.olympiad.time_left import busiest_worker_load, cell_seconds, rate_sources, task_throughputs, throughput
 
+    cells = set(plan.cells)
     try:
-        summaries = [s for s in read_summaries(results) if Cell.of_summary(s) in set(plan.cells)]
+        summaries = [s for s in read_summaries(results) if Cell.of_summary(s) in cells]
     except FileNotFoundError:
         summaries = []
     rates = task_throughputs(summaries)
-    if summaries:
-        fallback = sum(s["env_steps"] for s in summaries) / sum(s["train_wall_s"] for s in summaries)
-        source = "all the finished cells' throughput"
+    if rates:
+        fallback, source = throughput(summaries), "all the finished cells' throughput"
     elif started_rates:
         fallback, source = sum(started_rates) / len(started_rates), "the started cells' last evaluation rounds"
     else:

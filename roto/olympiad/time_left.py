@@ -26,16 +26,21 @@ def recent_rate(records: list[dict]) -> float | None:
     return (records[-1]["env_steps"] - records[-2]["env_steps"]) / seconds if seconds > 0 else None
 
 
+def throughput(summaries: Iterable[Mapping]) -> float:
+    """Finished cells' training env steps per second: all their env steps over all their training
+    seconds (``env_steps`` and ``train_wall_s`` of each summary); 0 without any."""
+    summaries = list(summaries)
+    seconds = sum(summary["train_wall_s"] for summary in summaries)
+    return sum(summary["env_steps"] for summary in summaries) / seconds if seconds > 0 else 0.0
+
+
 def task_throughputs(summaries: Iterable[Mapping]) -> dict[str, float]:
-    """Per task, the finished cells' training env steps per second: all its cells' env steps over
-    all their training seconds (``env_steps`` and ``train_wall_s`` of each summary)."""
-    steps: dict[str, float] = {}
-    seconds: dict[str, float] = {}
+    """Per task, the ``throughput`` of its finished cells' summaries (tasks without any left out)."""
+    by_task: dict[str, list[Mapping]] = {}
     for summary in summaries:
-        task = summary["task"]
-        steps[task] = steps.get(task, 0.0) + summary["env_steps"]
-        seconds[task] = seconds.get(task, 0.0) + summary["train_wall_s"]
-    return {task: steps[task] / seconds[task] for task in steps if seconds[task] > 0}
+        by_task.setdefault(summary["task"], []).append(summary)
+    rates = {task: throughput(group) for task, group in by_task.items()}
+    return {task: rate for task, rate in rates.items() if rate > 0}
 
 
 def cell_seconds(

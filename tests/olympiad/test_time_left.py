@@ -2,7 +2,14 @@
 
 import pytest
 
-from roto.olympiad.time_left import busiest_worker_load, cell_seconds, rate_sources, recent_rate, task_throughputs
+from roto.olympiad.time_left import (
+    busiest_worker_load,
+    cell_seconds,
+    rate_sources,
+    recent_rate,
+    task_throughputs,
+    throughput,
+)
 
 
 def test_the_busiest_worker_takes_whole_cells_largest_first():
@@ -26,6 +33,8 @@ def test_each_task_runs_at_its_own_finished_cells_throughput():
     ]
     rates = task_throughputs(summaries)
     assert rates == {"bounce": 2500.0, "baoding": 2000.0}
+    assert throughput(summaries) == pytest.approx(20_000_000 / 9000.0)  # every task's steps over every second
+    assert throughput([]) == 0.0 and task_throughputs([]) == {}
     task_of = {"a": "bounce", "b": "baoding", "c": "juggle"}
     seconds = cell_seconds({"a": 5_000_000, "b": 1_000_000, "c": 300}, task_of, rates, fallback=100.0)
     assert seconds == pytest.approx({"a": 2000.0, "b": 500.0, "c": 3.0})  # juggle has no cell: the fallback
