@@ -50,6 +50,11 @@ class NetworkConfig:
     and the std stays at the bound for the rest of the run."""
     obs_normalization: bool = True
     """Standardise each network's input with running statistics kept in the model (clip ±5)."""
+    start_at_hold: bool = False
+    """Start the policy's mean action at the hand's hold pose (``RotoEnv.hold_action``, the joint
+    targets of its default pose): the action layer's weights scaled by 0.01 (``HOLD_START_GAIN``) and its
+    bias set to the hold action, so every seed's first rollouts act near the hold pose, whatever its
+    random init. False: PyTorch's default init, a mean action of about ±0.4 per joint away from it."""
     actor: tuple[str, ...] | None = None
     """Groups the actor (and its encoder, which the auxiliary losses train) reads; None: the obs
     mode's groups. Always a subset of the obs mode's groups."""

@@ -17,6 +17,10 @@ from torch import nn
 from roto.rl.normalizers import RunningStandardScaler
 
 LOG_STD_MIN, LOG_STD_MAX = -20.0, 2.0
+HOLD_START_GAIN = 0.01
+"""Scale of the action layer's initial weights when a policy starts at a given action
+(``network.start_at_hold``): CleanRL's and RSL-RL's small output init, which keeps the mean action
+within about 0.01 of the start action for inputs of unit scale."""
 
 Obs = Mapping[str, torch.Tensor]
 """Observation groups: {group name: (N, stacked size)}."""
@@ -158,6 +162,18 @@ class ActorCritic(nn.Module):
         z = self.encode(obs)
         mean = self.policy_mean(self.policy_body(z))
         return mean, self.clamped_log_std(), self.value(obs, z), z
+
+    @torch.no_grad()
+    def start_mean_at(self, action: torch.Tensor, gain: float = HOLD_START_GAIN) -> None:
+        """Make the mean action start at ``action`` (n,) for every observation, up to ``gain``: the
+        action layer's weights scaled by ``gain``, its bias set to ``action``. Consumes no random
+        numbers, so the rest of a seeded run draws what it would have drawn."""
+        if action.shape != (self.num_actions,):
+            raise ValueError(f"start action must have shape ({self.num_actions},), got {tuple(action.shape)}")
+        if not 0 <= gain <= 1:
+            raise ValueError(f"gain must be in [0, 1], got {gain}")
+        self.policy_mean.weight.mul_(gain)
+        self.policy_mean.bias.copy_(action)
 
     @torch.no_grad()
     def act_deterministic(self, obs: Obs) -> torch.Tensor:

@@ -95,6 +95,8 @@ class Trainer:
         torch.manual_seed(spec.env.seed)
         sizes = stacked_sizes(self.env)
         self.model = build_model(sizes, self.env.num_actions, agent, spec.env.obs_mode).to(self.device)
+        if agent.network.start_at_hold:
+            self.model.start_mean_at(self.env.hold_action()[0].to(self.device))
         self.alg = build_learner(
             self.model, sizes, self.env.num_actions, spec.env.num_envs, agent, spec.env.seed, spec.env.touch
         )

@@ -318,3 +318,14 @@ def test_a_signal_stops_training_after_the_update_with_its_checkpoint_and_the_re
     resumed.train(progress=False)
     pw, pr = params(whole), params(resumed)
     assert all(torch.equal(pw[k], pr[k]) for k in pw)
+
+
+def test_start_at_hold_starts_the_policy_at_the_hold_pose_and_draws_the_same_random_numbers(tmp_path):
+    plain = tiny_trainer(tmp_path, "plain", 1)
+    held = tiny_trainer(tmp_path, "held", 1, ["network.start_at_hold=true"])
+    obs, _ = held.env.reset(seed=3)
+    hold = held.env.hold_action()
+    assert (held.model.act_deterministic(obs) - hold).abs().max() < 0.05
+    assert (plain.model.act_deterministic(obs) - hold).abs().max() > 0.2
+    same = [k for k in params(plain) if not k.startswith("policy_mean.")]
+    assert all(torch.equal(params(plain)[k], params(held)[k]) for k in same)  # only the action layer differs
