@@ -497,6 +497,18 @@ def test_baoding_cpu_is_its_round_bank_recipe_with_round_swaps_armed_as_the_arme
             assert cell_spec(study, cell).differences(blind_baoding(cell.robot, "baoding_cpu", seed=cell.seed)) == {}
 
 
+def test_the_hold_start_study_is_baoding_cpu_with_the_policy_started_at_the_hold_pose():
+    """experiments/baoding_hold_start: each cell differs from baoding_cpu's run on its seed (the
+    armed study's armed_round) only by where the policy's mean action starts."""
+    from roto.olympiad.cell import cell_spec
+
+    plan = plan_named("hold_start")
+    assert [(c.robot, c.seed) for c in plan.cells] == [("shadow", s) for s in range(10)]
+    for cell in plan.cells:
+        recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps, seed=cell.seed)
+        assert cell_spec(plan, cell).differences(recipe) == {"agent.network.start_at_hold": (True, False)}
+
+
 def test_the_round_bank_recipe_is_what_the_round_bank_study_trained_and_before_its_bank_what_the_others_did():
     """The frozen round-bank recipe is, on each hand, the Shadow's earlier recipe with the hand's
     round bank and the smaller encoder: what experiments/baoding_round_bank trained as
