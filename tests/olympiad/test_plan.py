@@ -491,6 +491,7 @@ def test_baoding_cpu_is_its_round_bank_recipe_with_round_swaps_armed_as_the_arme
 
     for robot in ROBOTS:
         assert blind_baoding(robot, "baoding_cpu").differences(blind_baoding(robot, ROUND_BANK, ARMED)) == {}
+        assert blind_baoding(robot, earlier("armed")).differences(blind_baoding(robot, ROUND_BANK, ARMED)) == {}
     for name in ("armed", "armed_untuned"):
         study = plan_named(name)
         for cell in study.cells:
@@ -536,11 +537,12 @@ def test_the_round_bank_recipe_is_what_the_round_bank_study_trained_and_before_i
 
 
 def test_each_part_of_baoding_cpu_is_switched_off_by_exactly_one_ablation():
-    """experiments/baoding_ablations: every cell is baoding_cpu with one part off, one variant a part."""
+    """experiments/baoding_ablations: every cell is baoding_cpu as the armed study trained it
+    (experiments/baoding_configs/baoding_cpu_armed.yaml) with one part off, one variant a part."""
     from roto.olympiad.cell import cell_spec
 
     plan = plan_named("ablations")
-    recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps)
+    recipe = blind_baoding("shadow", earlier("armed"), steps=plan.steps)
     replayed = {"bank": "shadow_round_preswap", "share": 0.5, "record_lead": 10, "record_capacity": 1024}
     expected = {
         "no_round_swaps": {"env.aids.round_swaps": (None, {"min_turn": 0.25, "first_paid": True, "after": 2})},
