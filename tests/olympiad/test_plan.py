@@ -483,31 +483,32 @@ ROUND_BANK = earlier("round_bank")
 ARMED = ["env.aids.round_swaps={min_turn: 0.25, first_paid: true, after: 2}"]
 
 
-def test_baoding_cpu_is_its_round_bank_recipe_with_round_swaps_armed_as_the_armed_study_trained():
+def test_baoding_cpu_is_the_armed_recipe_started_at_the_hold_pose_as_the_studies_trained_them():
     """The packaged one-for-every-hand recipe is, on each hand, the frozen round-bank recipe plus
-    round swaps armed after 2 rotations: what experiments/baoding_armed_round_swaps trained as
-    armed_round, so that study's results are baoding_cpu's."""
+    round swaps armed after 2 rotations (what experiments/baoding_armed_round_swaps trained as
+    armed_round, frozen as baoding_cpu_armed) with the policy started at the hold pose: what
+    experiments/baoding_hold_start trained, so that study's results are baoding_cpu's."""
     from roto.olympiad.cell import cell_spec
 
     for robot in ROBOTS:
-        assert blind_baoding(robot, "baoding_cpu").differences(blind_baoding(robot, ROUND_BANK, ARMED)) == {}
-        assert blind_baoding(robot, earlier("armed")).differences(blind_baoding(robot, ROUND_BANK, ARMED)) == {}
+        armed = blind_baoding(robot, earlier("armed"))
+        assert armed.differences(blind_baoding(robot, ROUND_BANK, ARMED)) == {}
+        assert blind_baoding(robot, "baoding_cpu").differences(armed) == {"agent.network.start_at_hold": (True, False)}
     for name in ("armed", "armed_untuned"):
         study = plan_named(name)
         for cell in study.cells:
-            assert cell_spec(study, cell).differences(blind_baoding(cell.robot, "baoding_cpu", seed=cell.seed)) == {}
+            assert cell_spec(study, cell).differences(blind_baoding(cell.robot, earlier("armed"), seed=cell.seed)) == {}
 
 
-def test_the_hold_start_study_is_baoding_cpu_with_the_policy_started_at_the_hold_pose():
-    """experiments/baoding_hold_start: each cell differs from baoding_cpu's run on its seed (the
-    armed study's armed_round) only by where the policy's mean action starts."""
+def test_the_hold_start_study_is_baoding_cpu():
+    """experiments/baoding_hold_start trained today's baoding_cpu, seeds 0-9 of the blind Shadow."""
     from roto.olympiad.cell import cell_spec
 
     plan = plan_named("hold_start")
     assert [(c.robot, c.seed) for c in plan.cells] == [("shadow", s) for s in range(10)]
     for cell in plan.cells:
         recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps, seed=cell.seed)
-        assert cell_spec(plan, cell).differences(recipe) == {"agent.network.start_at_hold": (True, False)}
+        assert cell_spec(plan, cell).differences(recipe) == {}
 
 
 def test_the_round_bank_recipe_is_what_the_round_bank_study_trained_and_before_its_bank_what_the_others_did():
