@@ -559,6 +559,24 @@ def test_each_part_of_baoding_cpu_is_switched_off_by_exactly_one_ablation():
         assert cell_spec(plan, cell).differences(recipe.with_seed(cell.seed)) == expected[cell.variant], cell.variant
 
 
+def test_each_part_of_todays_baoding_cpu_is_switched_off_by_exactly_one_hold_ablation():
+    """experiments/baoding_ablations/ablations_hold.yaml: every cell is today's baoding_cpu (the
+    hold-pose start) with one part off, the same parts as the armed recipe's ablations."""
+    from roto.olympiad.cell import cell_spec
+
+    plan, armed = plan_named("ablations_hold"), plan_named("ablations")
+    recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps)
+    assert {c.seed for c in plan.cells} == {0, 1, 2} and len(plan.cells) == len(armed.cells)
+    for cell in plan.cells:
+        part = cell.variant.removeprefix("hold_")
+        same_part = cell_spec(armed, Cell("baoding", "shadow", "blind", part, cell.seed))
+        expected = cell_spec(plan, cell).differences(recipe.with_seed(cell.seed))
+        assert expected and expected == same_part.differences(
+            blind_baoding("shadow", earlier("armed"), steps=plan.steps, seed=cell.seed)
+        )
+        assert cell_spec(plan, cell).differences(same_part) == {"agent.network.start_at_hold": (True, False)}
+
+
 @pytest.mark.parametrize(
     "name, variant, seeds, pin, after",
     [  # first_paid's pair baoding_cpu's runs from before its round bank; the others today's
