@@ -322,7 +322,10 @@ def test_a_signal_stops_training_after_the_update_with_its_checkpoint_and_the_re
 
 def test_start_at_hold_starts_the_policy_at_the_hold_pose_and_draws_the_same_random_numbers(tmp_path):
     plain = tiny_trainer(tmp_path, "plain", 1)
+    plain_rng = torch.get_rng_state()
     held = tiny_trainer(tmp_path, "held", 1, ["network.start_at_hold=true"])
+    assert torch.equal(torch.get_rng_state(), plain_rng)  # the start drew no random number
+    assert torch.equal(held.alg.generator.get_state(), plain.alg.generator.get_state())
     obs, _ = held.env.reset(seed=3)
     hold = held.env.hold_action()
     assert (held.model.act_deterministic(obs) - hold).abs().max() < 0.05
