@@ -511,6 +511,21 @@ def test_the_hold_start_study_is_baoding_cpu():
         assert cell_spec(plan, cell).differences(recipe) == {}
 
 
+def test_the_every_hand_hold_study_trains_exactly_the_benchmarks_blind_baoding_cells_of_the_other_hands():
+    """experiments/baoding_hold_every_hand's cells are the benchmark's (same names and run specs), so
+    its summaries count there; seed 0 of every hand trains before any hand's seed 1."""
+    from roto.olympiad.cell import cell_spec
+
+    plan, benchmark = plan_named("hold_every_hand"), load_plan("benchmark")
+    others = [robot for robot in ROBOTS if robot != "shadow"]
+    assert [(c.robot, c.obs, c.seed) for c in plan.cells] == [
+        (robot, "blind", seed) for seed in range(5) for robot in others
+    ]
+    shared = {c.name: c for c in benchmark.cells}
+    for cell in plan.cells:
+        assert cell_spec(plan, cell).differences(cell_spec(benchmark, shared[cell.name])) == {}
+
+
 def test_the_round_bank_recipe_is_what_the_round_bank_study_trained_and_before_its_bank_what_the_others_did():
     """The frozen round-bank recipe is, on each hand, the Shadow's earlier recipe with the hand's
     round bank and the smaller encoder: what experiments/baoding_round_bank trained as
