@@ -1,0 +1,51 @@
+"""How long an untrained policy's first training episodes last, per hand and seed, with and
+without the hold-pose start: one episode in each of 128 training envs of a fresh ``baoding_cpu``
+trainer (its aids on, its policy std), nothing learned.
+
+    python experiments/baoding_hold_every_hand/first_episodes.py [robot ...]
+
+Prints one line per (robot, start): the seeds' mean first-episode lengths in control steps.
+"""
+
+import sys
+import tempfile
+
+import torch
+
+from roto.rl.run_spec import build_run_spec
+from roto.rl.runner import Trainer
+
+SEEDS = range(5)
+MAX_STEPS = 600
+
+
+def first_episode_length(robot: str, seed: int, hold: bool) -> float:
+    """Mean over the training envs of the first episode's length (steps) of a fresh trainer."""
+    overrides = [f"network.start_at_hold={str(hold).lower()}"]
+    spec = build_run_spec("baoding", robot, "blind", "baoding_cpu", overrides, 1, num_envs=128, threads=1, seed=seed)
+    with tempfile.TemporaryDirectory() as run_dir, Trainer(spec, run_dir, tensorboard=False) as trainer:
+        obs, _ = trainer.env.reset(seed=seed)
+        length = torch.full((spec.env.num_envs,), float(MAX_STEPS))
+        open_ = torch.ones(spec.env.num_envs, dtype=torch.bool)
+        with torch.no_grad():
+            for step in range(1, MAX_STEPS + 1):
+                obs, _, terminated, truncated, _ = trainer.env.step(trainer.alg.act(obs))
+                ended = (terminated | truncated).cpu() & open_
+                length[ended] = step
+                open_ &= ~ended
+                if not open_.any():
+                    break
+        return float(length.mean())
+
+
+def main(robots: list[str]) -> None:
+    torch.set_num_threads(1)
+    for robot in robots:
+        for hold in (False, True):
+            lengths = [first_episode_length(robot, seed, hold) for seed in SEEDS]
+            shown = ", ".join(f"{value:.0f}" for value in lengths)
+            print(f"{robot:12s} start_at_hold={hold!s:5s} first episodes by seed {list(SEEDS)}: {shown}", flush=True)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:] or ["shadow", "shadow_lite", "allegro", "orca"])
