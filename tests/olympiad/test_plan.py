@@ -511,6 +511,17 @@ def test_the_hold_start_study_is_baoding_cpu():
         assert cell_spec(plan, cell).differences(recipe) == {}
 
 
+def test_the_kl_target_study_is_baoding_cpu_with_only_its_kl_target_doubled():
+    """experiments/baoding_kl_target pairs each seed with baoding_hold_start's run of baoding_cpu."""
+    from roto.olympiad.cell import cell_spec
+
+    plan = plan_named("kl_target")
+    assert [(c.robot, c.seed) for c in plan.cells] == [("shadow", s) for s in range(5)]
+    for cell in plan.cells:
+        recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps, seed=cell.seed)
+        assert cell_spec(plan, cell).differences(recipe) == {"agent.ppo.kl_target": (0.016, 0.008)}
+
+
 def test_the_every_hand_hold_study_trains_exactly_the_benchmarks_blind_baoding_cells_of_the_other_hands():
     """experiments/baoding_hold_every_hand's cells are the benchmark's (same names and run specs), so
     its summaries count there; seed 0 of every hand trains before any hand's seed 1."""
