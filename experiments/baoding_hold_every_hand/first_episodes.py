@@ -12,11 +12,11 @@ import tempfile
 
 import torch
 
+from roto.envs.episodes import first_episodes
 from roto.rl.run_spec import build_run_spec
 from roto.rl.runner import Trainer
 
 SEEDS = range(5)
-MAX_STEPS = 600
 
 
 def first_episode_length(robot: str, seed: int, hold: bool) -> float:
@@ -25,17 +25,8 @@ def first_episode_length(robot: str, seed: int, hold: bool) -> float:
     spec = build_run_spec("baoding", robot, "blind", "baoding_cpu", overrides, 1, num_envs=128, threads=1, seed=seed)
     with tempfile.TemporaryDirectory() as run_dir, Trainer(spec, run_dir, tensorboard=False) as trainer:
         obs, _ = trainer.env.reset(seed=seed)
-        length = torch.full((spec.env.num_envs,), float(MAX_STEPS))
-        open_ = torch.ones(spec.env.num_envs, dtype=torch.bool)
         with torch.no_grad():
-            for step in range(1, MAX_STEPS + 1):
-                obs, _, terminated, truncated, _ = trainer.env.step(trainer.alg.act(obs))
-                ended = (terminated | truncated).cpu() & open_
-                length[ended] = step
-                open_ &= ~ended
-                if not open_.any():
-                    break
-        return float(length.mean())
+            return float(first_episodes(trainer.env, trainer.alg.act, obs)["length"].mean())
 
 
 def main(robots: list[str]) -> None:
