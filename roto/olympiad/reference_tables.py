@@ -144,18 +144,19 @@ def lead_by_mode(summaries: list[dict]) -> dict[tuple[str, str, str], list[np.nd
 
 
 def overview_table(summaries: list[dict]) -> str:
-    """Markdown for the README: hands as rows, (task, obs mode) as columns, each cell the task's lead
-    measure (``lead_measure``: bounces, Baoding's round rotations) as the mean over seeds of the best
+    """Markdown for the README: a row per hand and task, a column per obs mode (so the header stays
+    short and four hands by two tasks take ten lines), each cell the task's lead measure
+    (``lead_measure``: bounces, Baoding's round rotations) as the mean over seeds of the best
     policies, and the seed count."""
     found = lead_by_mode(summaries)
-    order = {name: i for i, name in enumerate([*TASKS, *OBS_MODES])}
-    columns = sorted({(task, obs) for task, _, obs in found}, key=lambda c: (order[c[0]], order[c[1]]))
+    columns = [obs for obs in OBS_MODES if any(o == obs for _, _, o in found)]
     robots = sorted({robot for _, robot, _ in found}, key=lambda r: _row_order((r, "blind", "")))
-    head = ["hand", *(f"{task} {obs}" for task, obs in columns)]  # the measures: each task's lead_measure
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines = ["| " + " | ".join(["hand", "task", *columns]) + " |", "|" + "---|" * (len(columns) + 2)]
     for robot in robots:
-        cells = [" / ".join(f"{v.mean():.1f} (n={v.size})" for v in found.get((t, robot, o), [])) for t, o in columns]
-        lines.append("| " + " | ".join([robot, *cells]) + " |")
+        for task in [t for t in TASKS if any(key[:2] == (t, robot) for key in found)]:
+            seeds = [found.get((task, robot, obs), []) for obs in columns]
+            cells = [" / ".join(f"{v.mean():.1f} (n={v.size})" for v in values) for values in seeds]
+            lines.append("| " + " | ".join([robot, task, *cells]) + " |")
     return "\n".join(lines)
 
 

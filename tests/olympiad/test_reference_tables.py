@@ -87,9 +87,10 @@ def test_a_plan_names_each_hands_config_and_aids():
 def test_the_overview_is_a_few_short_lines():
     table = overview_table(SUMMARIES)
     lines = table.splitlines()
-    assert lines[0] == "| hand | bounce blind | bounce state | baoding blind |"
-    assert lines[2] == "| shadow | 40.0 (n=4) |  | 4.0 (n=2) |"  # Baoding's round rotations
-    assert lines[3] == "| allegro |  | 4.5 (n=1) |  |" and len(lines) == 4
+    assert lines[0] == "| hand | task | blind | state |"
+    assert lines[2] == "| shadow | bounce | 40.0 (n=4) |  |"
+    assert lines[3] == "| shadow | baoding | 4.0 (n=2) |  |"  # Baoding's round rotations
+    assert lines[4] == "| allegro | bounce |  | 4.5 (n=1) |" and len(lines) == 5
 
 
 def write_folder(path, summaries):
