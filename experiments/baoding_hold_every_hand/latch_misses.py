@@ -56,7 +56,7 @@ def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
     config = for_path_metrics(spec.cpu_env_config().without_training_aids())
     config = dataclasses.replace(config, num_envs=episodes, seed=EVAL_SEED, backend="cpu", device="cpu")
     env = RotoEnv(config)
-    recorder = BallPathRecorder(policy_groups(model.act_deterministic, config), 2)
+    recorder = BallPathRecorder(policy_groups(model.act_deterministic, config), len(env.balls))
     obs, _ = env.reset(seed=EVAL_SEED)
     with torch.no_grad():
         result = first_episodes(env, recorder, obs)

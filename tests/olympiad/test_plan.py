@@ -538,6 +538,20 @@ def test_the_every_hand_hold_study_trains_exactly_the_benchmarks_blind_baoding_c
         assert cell_spec(plan, cell).differences(cell_spec(benchmark, shared[cell.name])) == {}
 
 
+def test_the_allegros_20m_plan_continues_the_every_hand_studys_allegro_cells_with_only_a_larger_budget():
+    """experiments/baoding_hold_every_hand/allegro_20m.yaml: each cell is hold_every_hand's Allegro cell
+    of that seed but for its budget, so a run directory copied over from there continues (Trainer.open)."""
+    from roto.olympiad.cell import cell_spec
+
+    longer, study = plan_named("allegro_20m"), plan_named("hold_every_hand")
+    shared = {c.name: c for c in study.cells}
+    assert longer.cells and {c.robot for c in longer.cells} == {"allegro"}
+    for cell in longer.cells:
+        mine, theirs = cell_spec(longer, cell), cell_spec(study, shared[cell.name])
+        assert mine.differences(theirs) == {}
+        assert (mine.steps, theirs.steps) == (20_000_000, 10_000_000)
+
+
 def test_the_round_bank_recipe_is_what_the_round_bank_study_trained_and_before_its_bank_what_the_others_did():
     """The frozen round-bank recipe is, on each hand, the Shadow's earlier recipe with the hand's
     round bank and the smaller encoder: what experiments/baoding_round_bank trained as

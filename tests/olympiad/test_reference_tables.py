@@ -93,6 +93,19 @@ def test_the_overview_is_a_few_short_lines():
     assert lines[4] == "| allegro | bounce |  | 4.5 (n=1) |" and len(lines) == 5
 
 
+def test_the_overview_of_the_whole_table_keeps_ten_lines_under_an_80_character_header():
+    lead = {"bounce": "bounces_mean", "baoding": "round_rotations_mean"}
+    whole = [
+        summary(task, robot, obs, "ppo", 0, {lead[task]: 1.0, "rotations_mean": 1.0})
+        for task in ("bounce", "baoding")
+        for robot in ("shadow", "shadow_lite", "allegro", "orca")
+        for obs in ("blind", "state", "proprio")
+    ]
+    lines = overview_table(whole).splitlines()
+    assert lines[0] == "| hand | task | blind | state | proprio |" and len(lines[0]) < 80
+    assert len(lines) == 10 and lines[-1] == "| orca | baoding | 1.0 (n=1) | 1.0 (n=1) | 1.0 (n=1) |"
+
+
 def write_folder(path, summaries):
     path.mkdir()
     for s in summaries:
