@@ -10,6 +10,9 @@ own latch-and-swap rule (``roto.tasks.baoding.baoding_rule``) on them with latch
 4 cm. At 1 cm (the task's) the recount comes within about 1 % of the episodes' own rotations,
 printed beside it as a check (the recorder keeps the balls before each action, so an episode's last
 step is not replayed); net turns (``roto.tasks.pair_turns``) are what a path carried round makes.
+Where the balls go round: their mean centre relative to the targets' midpoint (x along the fingers,
+z up, cm; the first second of each episode, while the dropped balls settle, left out) and how near
+each ball came to its nearer target in an episode (median over episodes, cm).
 """
 
 import argparse
@@ -26,6 +29,8 @@ from roto.tasks.baoding import baoding_rule, geometry_of
 from roto.tasks.pair_turns import pair_turns
 
 RADII_CM = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0)
+SETTLE_STEPS = 60
+"""Control steps (1 s) left out of ``path_offsets``: the dropped balls are still falling."""
 
 
 def recounted_rotations(
@@ -50,6 +55,26 @@ def recounted_rotations(
     return swaps / 2
 
 
+def path_offsets(path: torch.Tensor, lengths: torch.Tensor, targets: torch.Tensor) -> dict[str, float]:
+    """Where the balls went round, in cm: their mean centre minus the targets' midpoint ("dx", "dy",
+    "dz"), and each ball's closest approach to its nearer target in an episode, median over the
+    episodes ("nearest a", "nearest b").
+
+    Args:
+        path: (T, B, 2, 3) balls a and b at each step, task frame; lengths: (B,) each episode's steps;
+        targets: (2, 3) the task's targets.
+    """
+    steps = torch.arange(path.shape[0])[:, None]
+    kept = (steps >= SETTLE_STEPS) & (steps < lengths[None])  # (T, B)
+    centres = path[kept].reshape(-1, 3).double()  # both balls of every kept step
+    offset = 100 * (centres.mean(0) - targets.mean(0))
+    near = (path[:, :, :, None].double() - targets[None, None, None]).norm(dim=-1).amin(dim=-1)  # (T, B, 2)
+    near = torch.where(kept[..., None], near, torch.inf).amin(dim=0)  # (B, 2)
+    nearest = 100 * near.median(dim=0).values
+    row = dict(zip(("dx", "dy", "dz"), offset.tolist(), strict=True))
+    return row | {"nearest a": float(nearest[0]), "nearest b": float(nearest[1])}
+
+
 def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
     """(hand, mean over the episodes of their own rotations, net turns and recounted rotations per radius)."""
     model, spec = load_policy(checkpoint)
@@ -68,7 +93,7 @@ def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
     row = {"rotations": float(result["rotations"][:, 0].mean()), "net_turns": sum(net) / len(net)}
     for radius in RADII_CM:
         row[f"r={radius:g} cm"] = float(recounted_rotations(path, lengths, targets, radius / 100).mean())
-    return spec.env.robot, row
+    return spec.env.robot, row | path_offsets(path, lengths, targets)
 
 
 def main() -> None:
