@@ -12,7 +12,10 @@ printed beside it as a check (the recorder keeps the balls before each action, s
 step is not replayed); net turns (``roto.tasks.pair_turns``) are what a path carried round makes.
 Where the balls go round: their mean centre relative to the targets' midpoint (x along the fingers,
 z up, cm; the first second of each episode, while the dropped balls settle, left out) and how near
-each ball came to its nearer target in an episode (median over episodes, cm).
+each ball came to its nearer target in an episode (median over episodes, cm). What turn shaping
+would pay if it paid only near the targets: the pair's net turning in the palm's plane (the turns
+turn shaping pays, ``roto.tasks.round_swaps.pair_turn_step``) over the steps with the pair's centre
+within 1, 1.5 and 2 times half the targets' separation of their midpoint.
 """
 
 import argparse
@@ -27,8 +30,10 @@ from roto.eval.evaluate import EVAL_SEED, policy_groups
 from roto.rl.run_dir import load_policy
 from roto.tasks.baoding import baoding_rule, geometry_of
 from roto.tasks.pair_turns import pair_turns
+from roto.tasks.round_swaps import pair_turn_step
 
 RADII_CM = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0)
+CENTRE_SCALES = (1.0, 1.5, 2.0)
 SETTLE_STEPS = 60
 """Control steps (1 s) left out of ``path_offsets``: the dropped balls are still falling."""
 
@@ -75,6 +80,33 @@ def path_offsets(path: torch.Tensor, lengths: torch.Tensor, targets: torch.Tenso
     return row | {"nearest a": float(nearest[0]), "nearest b": float(nearest[1])}
 
 
+def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch.Tensor) -> dict[str, float]:
+    """The pair's net turns in the palm's plane, all of them and those made with the pair's centre
+    within each of ``CENTRE_SCALES`` times half the targets' separation of the targets' midpoint,
+    episode mean (signs kept per episode, magnitudes averaged).
+
+    Args:
+        path: (T, B, 2, 3) balls a and b at each step, task frame; lengths: (B,) each episode's steps;
+        targets: (2, 3) the task's targets.
+    """
+    steps, batch = path.shape[:2]
+    angle = torch.zeros(batch, dtype=torch.float64)
+    angle_set = torch.zeros(batch, dtype=torch.bool)
+    half = float((targets[0] - targets[1]).norm()) / 2
+    centre_offset = (path.double().mean(dim=2) - targets.mean(0)).norm(dim=-1)  # (T, B)
+    total = torch.zeros(batch, dtype=torch.float64)
+    near = {scale: torch.zeros(batch, dtype=torch.float64) for scale in CENTRE_SCALES}
+    for t in range(steps):
+        angle, turn = pair_turn_step(path[t].double(), angle, angle_set)
+        angle_set = angle_set | True
+        turn = torch.where(t < lengths, turn, 0.0)
+        total += turn
+        for scale in CENTRE_SCALES:
+            near[scale] += torch.where(centre_offset[t] < scale * half, turn, 0.0)
+    row = {"plane turns": float(total.abs().mean())}
+    return row | {f"near {scale:g}x": float(value.abs().mean()) for scale, value in near.items()}
+
+
 def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
     """(hand, mean over the episodes of their own rotations, net turns and recounted rotations per radius)."""
     model, spec = load_policy(checkpoint)
@@ -93,7 +125,7 @@ def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
     row = {"rotations": float(result["rotations"][:, 0].mean()), "net_turns": sum(net) / len(net)}
     for radius in RADII_CM:
         row[f"r={radius:g} cm"] = float(recounted_rotations(path, lengths, targets, radius / 100).mean())
-    return spec.env.robot, row | path_offsets(path, lengths, targets)
+    return spec.env.robot, row | path_offsets(path, lengths, targets) | turns_near_targets(path, lengths, targets)
 
 
 def main() -> None:
