@@ -108,7 +108,9 @@ def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch
 
 
 def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
-    """(hand, mean over the episodes of their own rotations, net turns and recounted rotations per radius)."""
+    """(hand, over the episodes: their own rotations, net turns and recounted rotations per radius
+    (means), where the balls went round (``path_offsets``) and the turning near the targets
+    (``turns_near_targets``))."""
     model, spec = load_policy(checkpoint)
     config = for_path_metrics(spec.cpu_env_config().without_training_aids())
     config = dataclasses.replace(config, num_envs=episodes, seed=EVAL_SEED, backend="cpu", device="cpu")
