@@ -149,11 +149,12 @@ def overview_table(summaries: list[dict]) -> str:
     (``lead_measure``: bounces, Baoding's round rotations) as the mean over seeds of the best
     policies, and the seed count."""
     found = lead_by_mode(summaries)
-    columns = [obs for obs in OBS_MODES if any(o == obs for _, _, o in found)]
+    modes, rows = {obs for _, _, obs in found}, {(task, robot) for task, robot, _ in found}
+    columns = [obs for obs in OBS_MODES if obs in modes]
     robots = sorted({robot for _, robot, _ in found}, key=lambda r: _row_order((r, "blind", "")))
     lines = ["| " + " | ".join(["hand", "task", *columns]) + " |", "|" + "---|" * (len(columns) + 2)]
     for robot in robots:
-        for task in [t for t in TASKS if any(key[:2] == (t, robot) for key in found)]:
+        for task in [t for t in TASKS if (t, robot) in rows]:
             seeds = [found.get((task, robot, obs), []) for obs in columns]
             cells = [" / ".join(f"{v.mean():.1f} (n={v.size})" for v in values) for values in seeds]
             lines.append("| " + " | ".join([robot, task, *cells]) + " |")
