@@ -20,6 +20,7 @@ within 1, 1.5 and 2 times half the targets' separation of their midpoint.
 
 import argparse
 import dataclasses
+import math
 
 import torch
 
@@ -107,6 +108,24 @@ def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch
     return row | {f"near {scale:g}x": float(value.abs().mean()) for scale, value in near.items()}
 
 
+def turns_about_midpoint(path: torch.Tensor, lengths: torch.Tensor, targets: torch.Tensor) -> dict[str, float]:
+    """How far each ball winds round the targets' midpoint in the palm's plane (net turns, the mean
+    of the two balls, episode mean of magnitudes): what a pair carried round the targets makes, and
+    nearly nothing where the pair goes round a centre farther from the midpoint than the balls are
+    from their own centre.
+
+    Args:
+        path: (T, B, 2, 3) balls a and b at each step, task frame; lengths: (B,) each episode's steps;
+        targets: (2, 3) the task's targets.
+    """
+    offset = (path.double() - targets.mean(0))[..., :2]  # (T, B, 2, 2) palm-plane offsets
+    angle = torch.atan2(offset[..., 1], offset[..., 0])  # (T, B, 2)
+    step = torch.remainder(angle.diff(dim=0) + math.pi, 2 * math.pi) - math.pi  # (T-1, B, 2)
+    kept = torch.arange(1, path.shape[0])[:, None] < lengths[None]  # (T-1, B)
+    winding = torch.where(kept[..., None], step, 0.0).sum(dim=0).mean(dim=1) / (2 * math.pi)  # (B,)
+    return {"about midpoint": float(winding.abs().mean())}
+
+
 def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
     """(hand, over the episodes: their own rotations, net turns and recounted rotations per radius
     (means), where the balls went round (``path_offsets``) and the turning near the targets
@@ -127,7 +146,9 @@ def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
     row = {"rotations": float(result["rotations"][:, 0].mean()), "net_turns": sum(net) / len(net)}
     for radius in RADII_CM:
         row[f"r={radius:g} cm"] = float(recounted_rotations(path, lengths, targets, radius / 100).mean())
-    return spec.env.robot, row | path_offsets(path, lengths, targets) | turns_near_targets(path, lengths, targets)
+    return spec.env.robot, row | path_offsets(path, lengths, targets) | turns_near_targets(
+        path, lengths, targets
+    ) | turns_about_midpoint(path, lengths, targets)
 
 
 def main() -> None:
