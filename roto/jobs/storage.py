@@ -28,7 +28,7 @@ import threading
 import time
 import urllib.parse
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import optuna
 import sqlalchemy.exc
@@ -342,14 +342,21 @@ def reclaim_now(study: optuna.Study, storage: optuna.storages.BaseStorage) -> li
     return failed
 
 
-def wait_for_running(study: optuna.Study, heartbeat: float, told: set[tuple[int, ...]]) -> bool:
-    """Whether trials still run; if so, wait one heartbeat (saying why, once per set of trials).
+def wait_for_running(
+    study: optuna.Study,
+    heartbeat: float,
+    told: set[tuple[int, ...]],
+    watched: Callable[[optuna.trial.FrozenTrial], bool] = lambda trial: True,
+) -> bool:
+    """Whether ``watched`` trials still run; if so, wait one heartbeat (saying why, once per set of
+    trials).
 
     A worker with nothing left to claim waits here rather than stopping: a running trial either
     finishes, or its worker has died and the trial is retried once its heartbeat is ``4 *
     heartbeat`` s old, by whichever worker is still looking. ``told``: the sets already announced.
     """
-    running = tuple(t.number for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)))
+    trials = study.get_trials(deepcopy=False, states=(TrialState.RUNNING,))
+    running = tuple(t.number for t in trials if watched(t))
     if not running:
         return False
     if running not in told:

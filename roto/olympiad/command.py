@@ -39,6 +39,14 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
         help="list the cells, which are done, and the time left; train nothing",
     )
     p.add_argument(
+        "--only",
+        nargs="+",
+        default=(),
+        metavar="PATTERN",
+        help="train (or list) only the cells whose names match one of these patterns ('bounce-*', "
+        "'*-state-*', '*-seed2'); the plan's other cells stay for workers without --only",
+    )
+    p.add_argument(
         "--adopt",
         nargs=2,
         metavar=("PLAN", "RESULTS"),
@@ -78,11 +86,12 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
 
     from roto.jobs.claims import launch_workers
     from roto.jobs.storage import reclaim_now, resolve_storage, storage_in_environment
-    from roto.olympiad.plan import load_plan
+    from roto.olympiad.plan import load_plan, select_cells
     from roto.olympiad.worker import enqueue_missing, open_olympiad, run_olympiad_worker
 
     args.storage = resolve_storage(args.storage)
     plan = load_plan(args.plan)  # checked before anything runs or is written
+    select_cells(plan, args.only)  # a pattern that matches no cell stops here, before anything runs
     if args.threads is not None:
         if args.threads < 1:
             raise ValueError(f"--threads must be >= 1, got {args.threads}")
@@ -98,7 +107,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     if args.dry_run:
         if args.workers < 1:
             raise ValueError(f"--workers must be >= 1, got {args.workers}")
-        print(dry_run_report(plan, args.root, results, args.storage, args.workers))
+        print(dry_run_report(select_cells(plan, args.only), args.root, results, args.storage, args.workers))
         return 0
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
@@ -107,7 +116,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         study, storage = open_olympiad(plan, args.root, args.storage)
         if args.reclaim_now:  # here, once: a worker reclaiming would take its siblings' fresh claims
             reclaim_now(study, storage)
-        enqueue_missing(study, plan, results)
+        enqueue_missing(study, select_cells(plan, args.only), results)
         argv = [
             args.plan,
             "--root",
@@ -120,11 +129,14 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
             str(args.torch_threads),
             "--threads",
             str(plan.threads),
+            *(["--only", *args.only] if args.only else []),
         ]
         with storage_in_environment(args.storage) as storage_argv:  # never on argv: /proc/PID/cmdline is public
             return launch_workers("olympiad", args.workers, argv + storage_argv)
     torch.set_num_threads(args.torch_threads)
-    finished = run_olympiad_worker(plan, args.root, results, args.storage, args.heartbeat, reclaim=args.reclaim_now)
+    finished = run_olympiad_worker(
+        plan, args.root, results, args.storage, args.heartbeat, reclaim=args.reclaim_now, only=args.only
+    )
     print(json.dumps({"plan": plan.name, "finished_by_this_worker": finished, "results": str(results)}))
     return 0
 

@@ -27,11 +27,12 @@ plans live in ``experiments/``. Everything a plan names is checked before anythi
 
 from __future__ import annotations
 
+import fnmatch
 import importlib.resources
 import itertools
 import pathlib
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from roto.envs.observations import OBS_MODES
@@ -201,6 +202,25 @@ def load_plan(plan: str) -> Plan:
         budgets={name: steps for name, steps in budgets.items() if steps != numbers["steps"]},
         **numbers,
     )
+
+
+def select_cells(plan: Plan, patterns: Sequence[str]) -> Plan:
+    """``plan`` with only the cells whose names match one of ``patterns`` (shell-style, as
+    ``fnmatch``: ``bounce-*``, ``*-state-*``, ``*-seed2``), in the plan's order; the plan itself
+    without patterns. The name stays the plan's, so the cells chosen share its queue, run
+    directories and results. ValueError naming a pattern that matches no cell."""
+    for pattern in patterns:
+        if not any(fnmatch.fnmatchcase(cell.name, pattern) for cell in plan.cells):
+            examples = ", ".join(cell.name for cell in plan.cells[:3])
+            raise ValueError(
+                f"--only {pattern!r} matches none of the {len(plan.cells)} cells of plan {plan.name!r}; "
+                f"a cell's name is task-hand-obs-variant-seedN (e.g. {examples}); "
+                "patterns as fnmatch: 'bounce-*', '*-seed2'"
+            )
+    if not patterns:
+        return plan
+    chosen = tuple(c for c in plan.cells if any(fnmatch.fnmatchcase(c.name, p) for p in patterns))
+    return replace(plan, cells=chosen)
 
 
 def _check_keys(data: Any, valid: set[str], where: str) -> None:

@@ -15,7 +15,7 @@ trains twice.
 from __future__ import annotations
 
 import pathlib
-from collections.abc import Callable
+from collections.abc import Callable, Collection, Sequence
 from typing import Any
 
 import optuna
@@ -28,7 +28,7 @@ from roto.jobs.flags import HEARTBEAT_S
 from roto.jobs.optuna_ids import storage_id
 from roto.jobs.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 from roto.olympiad.cell import code_commit, run_cell, summary_path
-from roto.olympiad.plan import Cell, Plan
+from roto.olympiad.plan import Cell, Plan, select_cells
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import checkpoint_path
 
@@ -80,17 +80,19 @@ def claim_next(
     study: optuna.Study,
     storage: optuna.storages.BaseStorage,
     trained: Callable[[str], int | None] = lambda cell: None,
+    wanted: Collection[str] | None = None,
 ) -> optuna.Trial | None:
     """Claim a waiting trial: retries and started cells before fresh ones, the most trained first,
     then by number; None when none waits. ``trained(cell name)``: the env steps its run has trained,
     None for a cell not started. A started cell's trial need not be a retry: Optuna's retries of one
     trial run out after ``roto.jobs.storage.MAX_RETRY`` (3), and a cell reclaimed at the end of
-    every sitting is then enqueued afresh, at the back of the queue.
+    every sitting is then enqueued afresh, at the back of the queue. ``wanted``: claim only the
+    trials of these cells (``--only``); None: any.
 
     As ``optuna.Study.ask`` claims one, but in this order: setting a waiting trial running is
     atomic in every storage, so two workers never claim the same trial.
     """
-    waiting = study.get_trials(deepcopy=False, states=(TrialState.WAITING,))
+    waiting = [t for t in study.get_trials(deepcopy=False, states=(TrialState.WAITING,)) if is_wanted(t, wanted)]
 
     def order(trial: optuna.trial.FrozenTrial) -> tuple[bool, int, int]:
         steps = trained(trial.user_attrs.get(CELL_ATTR, ""))
@@ -103,6 +105,11 @@ def claim_next(
         except UpdateFinishedTrialError:  # another worker claimed and finished it meanwhile
             continue
     return None
+
+
+def is_wanted(trial: optuna.trial.FrozenTrial, wanted: Collection[str] | None) -> bool:
+    """Whether ``trial`` trains one of the ``wanted`` cells (every trial when None)."""
+    return wanted is None or trial.user_attrs.get(CELL_ATTR) in wanted
 
 
 def trained_steps(run_dir: pathlib.Path) -> int | None:
@@ -121,12 +128,17 @@ def run_olympiad_worker(
     heartbeat: float = HEARTBEAT_S,
     env_factory: Callable[[Any], Any] = RotoEnv,
     reclaim: bool = False,
+    only: Sequence[str] = (),
 ) -> int:
     """Train cells until none is waiting or running; the number this worker finished.
-    ``reclaim``: first fail and retry every running cell (``--reclaim-now``)."""
+    ``reclaim``: first fail and retry every running cell (``--reclaim-now``). ``only``: cell name
+    patterns (``roto.olympiad.plan.select_cells``): enqueue, claim and wait for only those cells,
+    leaving the plan's others to workers without them."""
     results = pathlib.Path(results) if results is not None else pathlib.Path(root) / plan.name / "results"
     study, storage = open_olympiad(plan, root, storage_url)
-    enqueue_missing(study, plan, results)
+    chosen = select_cells(plan, only)
+    enqueue_missing(study, chosen, results)
+    wanted = {cell.name for cell in chosen.cells} if only else None
     cells = {cell.name: cell for cell in plan.cells}
     root_dir = pathlib.Path(root) / plan.name
     commit = code_commit()  # the code this worker trains with, read before the checkout can move on
@@ -135,9 +147,11 @@ def run_olympiad_worker(
     finished, told = 0, set()
     while True:
         fail_stale_trials(study, storage, grace=4 * heartbeat)
-        trial = claim_next(study, storage, lambda name: trained_steps(root_dir / name) if name in cells else None)
-        if trial is None:
-            if wait_for_running(study, heartbeat, told):  # a dead worker's cell comes back as a retry
+        trial = claim_next(
+            study, storage, lambda name: trained_steps(root_dir / name) if name in cells else None, wanted
+        )
+        if trial is None:  # while one of its cells runs elsewhere, wait: a dead worker's comes back as a retry
+            if wait_for_running(study, heartbeat, told, lambda t: is_wanted(t, wanted)):
                 continue
             return finished
         name = trial.user_attrs.get(CELL_ATTR)

@@ -4,7 +4,7 @@ import pathlib
 import pytest
 
 from roto.envs.replay_starts import packaged_banks
-from roto.olympiad.plan import Cell, load_plan, packaged_plans
+from roto.olympiad.plan import Cell, load_plan, packaged_plans, select_cells
 from roto.rl.config import load_agent_config
 from roto.robots import ROBOTS
 
@@ -165,6 +165,37 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
                  str(tmp_path / "none")]) == 0  # fmt: skip
     # the 10 M cells 170 M and 160 M, the 46 of 5 M 110 M and 120 M, the 2.5 M one: 282.5 M = 113000 s
     assert "with 2 workers: 31.4 h" in (capsys.readouterr().out)
+
+
+def test_only_keeps_the_cells_a_pattern_matches_in_the_plans_order_and_refuses_one_that_matches_none():
+    plan = load_plan("benchmark")
+    assert select_cells(plan, ()) is plan
+    bounce = select_cells(plan, ["bounce-*"])
+    assert bounce.name == plan.name and bounce.steps_for(bounce.cells[0]) == plan.steps_for(bounce.cells[0])
+    assert bounce.cells == tuple(c for c in plan.cells if c.task == "bounce") and len(bounce.cells) == 36
+    picked = select_cells(plan, ["*-state-*-seed2", "baoding-allegro-blind-*"])
+    expected = [c for c in plan.cells if (c.obs == "state" and c.seed == 2) or (c.task, c.robot, c.obs) == (
+        "baoding", "allegro", "blind")]  # fmt: skip
+    assert list(picked.cells) == expected and len(expected) == 8 + 5
+    message = r"--only 'bounce-r2d2-\*' matches none of the 80 cells of plan 'benchmark'; .*e\.g\. bounce-shadow-blind"
+    with pytest.raises(ValueError, match=message):
+        select_cells(plan, ["bounce-*", "bounce-r2d2-*"])
+
+
+def test_cli_only_lists_the_chosen_cells_and_refuses_a_pattern_that_matches_none_before_anything_runs(tmp_path, capsys):
+    from roto.cli import main
+
+    root, results = tmp_path / "runs", tmp_path / "results"
+    argv = ["olympiad", "benchmark", "--dry-run", "--root", str(root), "--results", str(results)]
+    assert main([*argv, "--only", "*-orca-state-*"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("plan benchmark: 6 cells") and out.count("-orca-state-ppo-seed") == 6
+    assert "bounce-shadow" not in out and "6 left" in out
+    assert (
+        main(["olympiad", "benchmark", "--root", str(root), "--results", str(results), "--only", "baoding-ghost*"]) == 2
+    )
+    assert "--only 'baoding-ghost*' matches none of the 80 cells of plan 'benchmark'" in capsys.readouterr().err
+    assert not root.exists() and not results.exists()
 
 
 def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():

@@ -169,6 +169,36 @@ def test_a_waiting_cell_no_longer_in_the_plan_is_failed_with_its_name(tmp_path):
     assert ghost.user_attrs[REASON_ATTR] == "unknown cell 'bounce-ghost-blind-ppo-seed0': not in plan 'toy'"
 
 
+def test_a_worker_with_only_trains_only_its_cells_and_leaves_the_others_waiting_for_any_worker(tmp_path):
+    from roto.olympiad.worker import run_olympiad_worker
+    from tests.rl.toy_env import ToyEnv
+
+    plan_path = write_toy_plan(tmp_path, seeds=(0,))
+    plan, root = load_plan(str(plan_path)), tmp_path / "runs"
+    results = root / plan.name / "results"
+    study = optuna.create_study(study_name=study_name(plan), storage=open_storage(root / plan.name))
+    other = next(c.name for c in plan.cells if c.task == "baoding")
+    study.enqueue_trial({}, user_attrs={CELL_ATTR: other})  # queued by a worker without --only
+    assert run_olympiad_worker(plan, str(root), heartbeat=5.0, env_factory=ToyEnv, only=["bounce-*"]) == 2
+    trials = load_study(root, plan).trials
+    done = sorted(t.user_attrs[CELL_ATTR] for t in trials if t.state == TrialState.COMPLETE)
+    assert done == sorted(c.name for c in plan.cells if c.task == "bounce")
+    assert [t.user_attrs[CELL_ATTR] for t in trials if t.state == TrialState.WAITING] == [other]
+    assert sorted(p.stem for p in results.glob("*.json")) == done
+    assert run_olympiad_worker(plan, str(root), heartbeat=5.0, env_factory=ToyEnv) == 2  # the baoding cells
+    assert set(cell_status(plan, str(root), results, None).values()) == {"done"}
+
+
+def test_a_worker_waits_only_for_the_running_trials_it_watches():
+    from roto.jobs.storage import wait_for_running
+
+    study = optuna.create_study()
+    trial = study.ask()  # running, as a cell another worker trains
+    told = set()
+    assert not wait_for_running(study, 0.01, told, lambda t: False) and not told
+    assert wait_for_running(study, 0.01, told) and told == {(trial.number,)}
+
+
 def test_cli_olympiad_with_two_workers_on_the_real_env_then_results(tmp_path, capsys):
     from roto.cli import main
     from tests.olympiad.toy_plan import TINY
