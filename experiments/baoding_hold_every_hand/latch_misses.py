@@ -84,7 +84,9 @@ def path_offsets(path: torch.Tensor, lengths: torch.Tensor, targets: torch.Tenso
 def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch.Tensor) -> dict[str, float]:
     """The pair's net turns in the palm's plane, all of them and those made with the pair's centre
     within each of ``CENTRE_SCALES`` times half the targets' separation of the targets' midpoint,
-    episode mean (signs kept per episode, magnitudes averaged).
+    episode mean (signs kept per episode, magnitudes averaged); and what turn shaping gated there
+    would pay, in turns ("gated"): the growth of the pair's net turning made inside, less every
+    shrinking of it wherever it happens (so no loop, in and out, earns anything).
 
     Args:
         path: (T, B, 2, 3) balls a and b at each step, task frame; lengths: (B,) each episode's steps;
@@ -97,15 +99,20 @@ def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch
     centre_offset = (path.double().mean(dim=2) - targets.mean(0)).norm(dim=-1)  # (T, B)
     total = torch.zeros(batch, dtype=torch.float64)
     near = {scale: torch.zeros(batch, dtype=torch.float64) for scale in CENTRE_SCALES}
+    gated = {scale: torch.zeros(batch, dtype=torch.float64) for scale in CENTRE_SCALES}
     for t in range(steps):
         angle, turn = pair_turn_step(path[t].double(), angle, angle_set)
         angle_set = angle_set | True
         turn = torch.where(t < lengths, turn, 0.0)
+        grown = (total + turn).abs() - total.abs()  # what the turn shaping pays, in turns
         total += turn
         for scale in CENTRE_SCALES:
-            near[scale] += torch.where(centre_offset[t] < scale * half, turn, 0.0)
+            inside = centre_offset[t] < scale * half
+            near[scale] += torch.where(inside, turn, 0.0)
+            gated[scale] += torch.where(inside | (grown < 0), grown, 0.0)
     row = {"plane turns": float(total.abs().mean())}
-    return row | {f"near {scale:g}x": float(value.abs().mean()) for scale, value in near.items()}
+    row |= {f"near {scale:g}x": float(value.abs().mean()) for scale, value in near.items()}
+    return row | {f"gated {scale:g}x": float(value.mean()) for scale, value in gated.items()}
 
 
 def turns_about_midpoint(path: torch.Tensor, lengths: torch.Tensor, targets: torch.Tensor) -> dict[str, float]:

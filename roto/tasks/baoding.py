@@ -24,7 +24,7 @@ from roto.tasks.base import (
     uniform,
 )
 from roto.tasks.pair_turns import pair_turns
-from roto.tasks.round_swaps import paid_swaps, pair_turn_step, turn_shaping
+from roto.tasks.round_swaps import centre_near_targets, paid_swaps, pair_turn_step, turn_shaping
 
 BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
@@ -37,11 +37,14 @@ PARAMETER_FIELDS = MappingProxyType(
         "swap_first_paid": "first_paid",
         "turn_reward": "turn_reward",
         "turn_lead": "turn_lead",
+        "turn_near": "turn_near",
     }
 )
 """{task parameter: the ``BaodingState`` field that holds it}."""
 UNBOUNDED_LEAD = 1e9
 """``turn_lead`` of the turn-shaping aid when its paid turning is not bounded by the swaps (turns)."""
+ANYWHERE = 1e9
+"""``turn_near`` of the turn-shaping aid when turning pays wherever the pair is (half target separations)."""
 DENSE_SCALE = 0.1
 DENSE_LENGTH = 0.1
 """Dense reward 0.1 · Σ (1 − tanh(d / 0.1)) per step."""
@@ -149,6 +152,7 @@ class BaodingState:
     net_turn: torch.Tensor  # (B,) float64: the line's signed turns this episode
     turn_reward: torch.Tensor  # () float64: reward per turn the pair's net turning grows by
     turn_lead: torch.Tensor  # () float64: turns the paid turning may run ahead of half a turn per swap
+    turn_near: torch.Tensor  # () float64: turning pays with the pair's centre this many half target separations near
 
 
 def baoding_rule(
@@ -190,7 +194,8 @@ def follow_turns(state: BaodingState, pos: Array, swap: Array) -> dict[str, Arra
     )
     paid_turns = state.turn_lead + 0.5 * as_dtype_of(state.swaps, pos)  # turns the swaps so far back
     before = paid_turns - 0.5 * as_dtype_of(swap, pos)  # the bound before this step's swap
-    shaped, state.net_turn = turn_shaping(state.net_turn, turn, state.turn_reward, before, paid_turns)
+    here = centre_near_targets(pos, state.targets, state.turn_near)
+    shaped, state.net_turn = turn_shaping(state.net_turn, turn, state.turn_reward, before, paid_turns, here)
     return {"swap": paid, "turn": shaped}
 
 
@@ -211,13 +216,16 @@ class Baoding:
             "swap_first_paid": 0.0,
             "turn_reward": 0.0,
             "turn_lead": UNBOUNDED_LEAD,
+            "turn_near": ANYWHERE,
         }
     )
     """What training aids may change: the latch radius (m; a tolerance curriculum starts it wider,
     ``roto.envs.aids.tolerance``), the turns a paid swap must follow (0: every swap is paid; the
     round-swaps aid sets it, ``roto.tasks.round_swaps``), whether an episode's first swap is paid
-    without them (0: no; the same aid) and the reward per turn of the pair's net
-    turning (0: none; the turn-shaping aid sets it, ``roto.tasks.round_swaps.turn_shaping``)."""
+    without them (0: no; the same aid), the reward per turn of the pair's net turning (0: none; the
+    turn-shaping aid sets it, ``roto.tasks.round_swaps.turn_shaping``), the turns that paid turning
+    may run ahead of half a turn per swap (unbounded unless the aid's ``lead`` says) and how near
+    the targets the pair's centre must be for turning to pay (anywhere unless its ``near`` says)."""
     reference_name = "reference controller"
 
     @property
@@ -260,11 +268,12 @@ class Baoding:
             net_turn=torch.zeros(num_envs, dtype=torch.float64, device=device),
             turn_reward=torch.zeros((), dtype=torch.float64, device=device),
             turn_lead=torch.tensor(UNBOUNDED_LEAD, dtype=torch.float64, device=device),
+            turn_near=torch.tensor(ANYWHERE, dtype=torch.float64, device=device),
         )
 
     def set_parameter(self, state: BaodingState, name: str, value: float | torch.Tensor) -> None:
-        """Set ``success_radius``, ``swap_min_turn``, ``swap_first_paid``, ``turn_reward`` or
-        ``turn_lead`` of every world (``Task.set_parameter``)."""
+        """Set ``success_radius``, ``swap_min_turn``, ``swap_first_paid``, ``turn_reward``,
+        ``turn_lead`` or ``turn_near`` of every world (``Task.set_parameter``)."""
         set_state_parameter(state, PARAMETER_FIELDS, name, value)
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:

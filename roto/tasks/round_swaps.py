@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from roto.tasks.arrays import Array, atan2, minimum, where
+from roto.tasks.arrays import Array, atan2, minimum, vector_norm, where
 
 
 def pair_turn_step(ball_pos: Array, pair_angle: Array, angle_set: Array) -> tuple[Array, Array]:
@@ -63,7 +63,12 @@ def paid_swaps(
 
 
 def turn_shaping(
-    net_turn: Array, turn: Array, turn_reward: float | Array, cap: Array | float, new_cap: Array | float
+    net_turn: Array,
+    turn: Array,
+    turn_reward: float | Array,
+    cap: Array | float,
+    new_cap: Array | float,
+    paid_here: Array | bool = True,
 ) -> tuple[Array, Array]:
     """The turn-shaping reward: ``turn_reward`` per turn the pair's paid turning grows (pure; torch
     or numpy).
@@ -80,9 +85,31 @@ def turn_shaping(
         turn: (B,) signed turns this step (``pair_turn_step``).
         turn_reward: reward per turn (0: the benchmark, nothing paid).
         cap, new_cap: (B,) the paid turning's bound before and after this step.
+        paid_here: (B,) bool, or True everywhere: where False (Baoding: the pair's centre away from
+            the targets, ``centre_near_targets``) growth is not paid but shrinking is still charged.
+            Then the term is no longer potential-based, but no closed loop earns anything: a turn
+            out there and back here, or here and back there, sums to at most 0.
 
     Returns:
         (reward (B,), new net_turn (B,))
     """
     net = net_turn + turn
-    return turn_reward * (minimum(abs(net), new_cap) - minimum(abs(net_turn), cap)), net
+    grown = minimum(abs(net), new_cap) - minimum(abs(net_turn), cap)
+    return turn_reward * where(paid_here | (grown < 0), grown, 0.0), net
+
+
+def centre_near_targets(ball_pos: Array, targets: Array, near: float | Array) -> Array:
+    """Whether the pair's centre is within ``near`` times half the targets' separation of their
+    midpoint (pure; torch or numpy).
+
+    Args:
+        ball_pos: (B, 2, 3) ball centres, task frame.
+        targets: (2, 3) the two targets.
+        near: half target separations (large: everywhere).
+
+    Returns:
+        (B,) bool.
+    """
+    half = vector_norm(targets[0] - targets[1]) / 2.0
+    offset = vector_norm((ball_pos[:, 0] + ball_pos[:, 1]) / 2.0 - (targets[0] + targets[1]) / 2.0)
+    return offset < near * half

@@ -452,7 +452,7 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
     assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
         "env.aids.replayed_starts.bank": (round_bank, recipe.env.aids.replayed_starts.bank),
         "env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False, "after": None}, None),
-        "env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None}),  # the recipe's since it ran
+        "env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None, "near": None}),  # the recipe's since it ran
         "env.seed": (3, 0),
     }  # fmt: skip
     assert round_bank in packaged_banks()
@@ -619,7 +619,7 @@ def test_each_part_of_baoding_cpu_is_switched_off_by_exactly_one_ablation():
     replayed = {"bank": "shadow_round_preswap", "share": 0.5, "record_lead": 10, "record_capacity": 1024}
     expected = {
         "no_round_swaps": {"env.aids.round_swaps": (None, {"min_turn": 0.25, "first_paid": True, "after": 2})},
-        "no_turn_shaping": {"env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None})},
+        "no_turn_shaping": {"env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None, "near": None})},
         "no_replayed_starts": {"env.aids.replayed_starts": (None, replayed)},
         "no_recording": {"env.aids.replayed_starts.record_lead": (0, 10)},
         "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2})},

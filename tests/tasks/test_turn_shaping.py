@@ -11,9 +11,9 @@ import torch
 import roto
 from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
-from roto.tasks.baoding import Baoding
+from roto.tasks.baoding import Baoding, geometry_of
 from roto.tasks.base import TaskInputs
-from roto.tasks.round_swaps import turn_shaping
+from roto.tasks.round_swaps import centre_near_targets, turn_shaping
 from tests.tasks.test_round_swaps import SHADOW, path_round_the_targets
 
 
@@ -32,13 +32,15 @@ def test_the_shaping_pays_growth_of_the_net_turning_and_takes_it_back_as_it_shri
     assert float(reward[0]) == pytest.approx(1.0)
 
 
-def shaped_rewards(path, turn_reward, lead=None):
+def shaped_rewards(path, turn_reward, lead=None, near=None):
     """(sum of the "turn" term over ``path``, the terms' names) of one Baoding world."""
     task = Baoding()
     state = task.init_state(SHADOW, 1, torch.device("cpu"))
     task.set_parameter(state, "turn_reward", turn_reward)
     if lead is not None:
         task.set_parameter(state, "turn_lead", lead)
+    if near is not None:
+        task.set_parameter(state, "turn_near", near)
     total, names = 0.0, set()
     for pos in path:
         inputs = TaskInputs(
@@ -75,6 +77,43 @@ def test_bounded_by_the_swaps_a_pair_spun_without_swapping_earns_only_the_lead()
     assert shaped_rewards(spun, 20.0, lead=0.5)[0] == pytest.approx(10.0)  # bounded: half a turn
 
 
+def test_paid_only_here_growth_elsewhere_is_unpaid_and_shrinking_is_charged_anywhere():
+    net = torch.tensor([0.2, 0.2, 0.2, 0.2], dtype=torch.float64)
+    turn = torch.tensor([0.1, -0.1, 0.1, -0.1], dtype=torch.float64)
+    here = torch.tensor([True, True, False, False])
+    reward, new_net = turn_shaping(net, turn, 20.0, math.inf, math.inf, here)
+    assert reward.tolist() == pytest.approx([2.0, -2.0, 0.0, -2.0]) and new_net.tolist() == pytest.approx(
+        [0.3, 0.1, 0.3, 0.1]
+    )
+    assert turn_shaping(net, turn, 20.0, math.inf, math.inf)[0].tolist() == pytest.approx([2.0, -2.0, 2.0, -2.0])
+
+
+def test_the_pairs_centre_is_near_within_that_many_half_target_separations_of_their_midpoint():
+    targets = torch.tensor(geometry_of(SHADOW).targets, dtype=torch.float64)
+    half = float((targets[0] - targets[1]).norm()) / 2
+    pair = path_round_the_targets([0.5 * math.pi])[0]  # centred on the targets' midpoint
+    shifted = torch.stack([pair + torch.tensor([0.0, 0.0, k * half], dtype=torch.float64) for k in (0.0, 1.4, 1.6)])
+    assert centre_near_targets(shifted, targets, 1.5).tolist() == [True, True, False]
+    assert centre_near_targets(shifted, targets, 2.0).tolist() == [True, True, True]
+    assert centre_near_targets(shifted.numpy(), targets.numpy(), 1.5).tolist() == [True, True, False]
+
+
+def test_paid_only_near_the_targets_turning_off_them_earns_nothing_and_no_loop_in_and_out_earns():
+    round_path = path_round_the_targets(np.linspace(0.5 * math.pi, 4.5 * math.pi, 121))  # two turns
+    assert shaped_rewards(round_path, 20.0, near=1.5)[0] == pytest.approx(40.0)  # round the targets: all paid
+    spun = round_path + torch.tensor([0.0, 0.05, 0.0], dtype=torch.float64)  # 5 cm off: 2.5 half separations
+    assert shaped_rewards(spun, 20.0)[0] == pytest.approx(40.0)
+    assert shaped_rewards(spun, 20.0, near=1.5)[0] == pytest.approx(0.0)
+    assert shaped_rewards(spun, 20.0, near=3.0)[0] == pytest.approx(40.0)
+    half_turn = path_round_the_targets(np.linspace(0.5 * math.pi, 1.5 * math.pi, 31))
+    off = torch.tensor([0.0, 0.05, 0.0], dtype=torch.float64)
+    loop = torch.cat([half_turn, half_turn.flip(0) + off] * 3)  # out here, back off the targets, thrice
+    assert shaped_rewards(loop, 20.0)[0] == pytest.approx(0.0, abs=1e-9)
+    assert shaped_rewards(loop, 20.0, near=1.5)[0] == pytest.approx(0.0, abs=1e-9)
+    reverse = torch.cat([half_turn + off, half_turn.flip(0)] * 3)  # out off the targets, back here
+    assert shaped_rewards(reverse, 20.0, near=1.5)[0] == pytest.approx(-30.0)
+
+
 def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids={"turn_shaping": {"per_turn": 20.0}})
     assert float(env.task_state.turn_reward) == 20.0 and [type(a).__name__ for a in env.aids] == ["TurnShaping"]
@@ -86,6 +125,8 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     assert float(roto.make(**vars(settings.eval_env_config(2))).task_state.turn_reward) == 0.0
     bounded = roto.make("baoding", num_envs=1, aids={"turn_shaping": {"per_turn": 20.0, "lead": 0.5}})
     assert float(bounded.task_state.turn_lead) == 0.5 and float(env.task_state.turn_lead) == 1e9
+    near = roto.make("baoding", num_envs=1, aids={"turn_shaping": {"per_turn": 20.0, "near": 1.5}})
+    assert float(near.task_state.turn_near) == 1.5 and float(env.task_state.turn_near) == 1e9
 
 
 @pytest.mark.parametrize(
@@ -96,6 +137,8 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
         ("baoding", float("nan"), r"got nan"),
         ("baoding", "20", r"got '20'"),
         ("baoding", {"lead": -1.0}, r"aids.turn_shaping.lead must be a number of turns.*got -1.0"),
+        ("baoding", {"near": -1.5}, r"aids.turn_shaping.near must be a number of half target separations.*got -1.5"),
+        ("baoding", {"near": "far"}, r"aids.turn_shaping.near must be .*got 'far'"),
     ],
 )
 def test_bad_turn_reward_is_refused(task, per_turn, pattern):

@@ -136,16 +136,23 @@ class TurnShapingSettings:
         lead: None: every turn is paid; else the paid turning stops this many turns ahead of half
             a turn per swap made, so spinning the pair without the balls trading places pays at
             most ``lead`` turns an episode.
+        near: None: the turning pays wherever the pair is; else it pays only while the pair's
+            centre is within ``near`` times half the targets' separation of their midpoint (a
+            length each hand's targets give), and shrinking it is charged anywhere, so turning the
+            pair off the targets earns nothing and no loop, in and out, earns anything.
     """
 
     per_turn: float = 20.0
     lead: float | None = None
+    near: float | None = None
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "turn_reward", "a ball pair")
         _number(f"{path}.per_turn", self.per_turn, 0.0, 1000.0, "a reward per turn")
         if self.lead is not None:
             _number(f"{path}.lead", self.lead, 0.0, 100.0, "a number of turns (or null: unbounded)")
+        if self.near is not None:
+            _number(f"{path}.near", self.near, 0.0, 100.0, "a number of half target separations (or null: anywhere)")
 
 
 @dataclass(frozen=True, kw_only=True)
