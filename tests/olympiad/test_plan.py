@@ -553,6 +553,16 @@ def test_the_kl_target_study_is_baoding_cpu_with_only_its_kl_target_doubled():
         assert cell_spec(plan, cell).differences(recipe) == {"agent.ppo.kl_target": (0.016, 0.008)}
 
 
+def test_the_turn_near_probe_is_the_allegros_baoding_cpu_cell_with_only_its_turn_shaping_gated():
+    """experiments/baoding_turn_near probes the Allegro's seed 1, which baoding_cpu left turning off the targets."""
+    from roto.olympiad.cell import cell_spec
+
+    plan = plan_named("turn_near")
+    assert [c.name for c in plan.cells] == ["baoding-allegro-blind-near_1_5-seed1"] and plan.steps == 10_000_000
+    recipe = blind_baoding("allegro", "baoding_cpu", steps=plan.steps, seed=1)
+    assert cell_spec(plan, plan.cells[0]).differences(recipe) == {"env.aids.turn_shaping.near": (1.5, None)}
+
+
 def test_the_every_hand_hold_study_trains_exactly_the_benchmarks_blind_baoding_cells_of_the_other_hands():
     """experiments/baoding_hold_every_hand's cells are the benchmark's (same names and run specs), so
     its summaries count there; seed 0 of every hand trains before any hand's seed 1."""
