@@ -32,8 +32,9 @@ from roto.envs.start_pool import check_balls_start_clear
 from roto.envs.step_checks import StepChecks
 from roto.robots import get_robot
 from roto.robots.spec import RobotSpec
-from roto.sim.backend import Backend, make_backend
+from roto.sim.backend import Backend
 from roto.sim.host_sync import deliberate_host_sync, resolve_device
+from roto.sim.make_backend import make_backend
 from roto.sim.scene import build_scene
 from roto.tasks import get_task
 from roto.tasks.base import TaskInputs

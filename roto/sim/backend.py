@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
-import mujoco
 import numpy as np
 import torch
 
@@ -73,32 +72,3 @@ class Backend(Protocol):
 
 BACKENDS = ("cpu", "warp")
 """Physics backends: ``cpu`` (MuJoCo C in threads) and ``warp`` (MuJoCo Warp, GPU or Warp's CPU)."""
-
-
-def make_backend(
-    name: str,
-    model: mujoco.MjModel,
-    num_worlds: int,
-    *,
-    substeps: int,
-    threads: int = 1,
-    device: str = "cpu",
-    nconmax: int | None = None,
-    njmax: int | None = None,
-) -> Backend:
-    """The backend ``name`` for B = ``num_worlds`` worlds of ``model`` (Warp is imported only here).
-
-    ``threads`` applies to ``cpu``; ``device``, ``nconmax`` and ``njmax`` (per-world capacities)
-    to ``warp``.
-    """
-    if name == "cpu":
-        from roto.sim.mujoco_cpu import MujocoCpuBackend
-
-        return MujocoCpuBackend(model, num_worlds, substeps=substeps, threads=threads)
-    if name == "warp":
-        from roto.sim.mujoco_warp import MujocoWarpBackend
-
-        if nconmax is None or njmax is None:
-            raise ValueError("backend 'warp' needs the per-world capacities nconmax and njmax")
-        return MujocoWarpBackend(model, num_worlds, substeps=substeps, device=device, nconmax=nconmax, njmax=njmax)
-    raise ValueError(f"unknown backend {name!r}; valid backends: {list(BACKENDS)}")

@@ -12,7 +12,7 @@ import torch
 
 import roto
 from roto.robots import ROBOTS, get_robot
-from roto.sim.backend import make_backend
+from roto.sim.make_backend import make_backend
 from roto.sim.scene import BallSpec, build_scene
 from roto.tasks import TASKS
 from roto.tasks.baoding import rest_after_drop
