@@ -107,7 +107,8 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     if args.dry_run:
         if args.workers < 1:
             raise ValueError(f"--workers must be >= 1, got {args.workers}")
-        print(dry_run_report(select_cells(plan, args.only), args.root, results, args.storage, args.workers))
+        whole = len(plan.cells) if args.only else None
+        print(dry_run_report(select_cells(plan, args.only), args.root, results, args.storage, args.workers, whole))
         return 0
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
@@ -164,9 +165,12 @@ def status_metrics(task: Task, records: list[dict]) -> tuple[str, tuple[str, ...
     return lead, tuple(m for m in (task.headline_metric, *task.path_metric_names) if m != lead)
 
 
-def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1) -> str:
+def dry_run_report(
+    plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1, of_cells: int | None = None
+) -> str:
     """The cells and their status, and the time left for the env steps left (a started cell counts
-    the env steps of its run's last evaluation; ``time_left_estimate``)."""
+    the env steps of its run's last evaluation; ``time_left_estimate``). ``of_cells``: the plan's
+    whole count, when ``plan`` holds only the cells ``--only`` chose."""
     from roto.olympiad.time_left import recent_rate
     from roto.olympiad.worker import cell_status
     from roto.rl.evaluation import read_evaluations
@@ -177,7 +181,8 @@ def dry_run_report(plan: Plan, root: str, results: pathlib.Path, storage: str | 
     budgets = {cell.name: plan.steps_for(cell) for cell in plan.cells}
     uniform = len(set(budgets.values())) == 1
     each = f"{plan.steps} env steps each" if uniform else "env steps per cell as listed"
-    lines = [f"plan {plan.name}: {len(plan.cells)} cells, {each}", ""]
+    chosen = f" of its {of_cells} (--only)" if of_cells is not None else ""
+    lines = [f"plan {plan.name}: {len(plan.cells)} cells{chosen}, {each}", ""]
     done_steps, started_rates = {}, []
     for name, state in status.items():
         records = [] if state == "done" else read_evaluations(pathlib.Path(root) / plan.name / name)

@@ -189,7 +189,8 @@ def test_cli_only_lists_the_chosen_cells_and_refuses_a_pattern_that_matches_none
     argv = ["olympiad", "benchmark", "--dry-run", "--root", str(root), "--results", str(results)]
     assert main([*argv, "--only", "*-orca-state-*"]) == 0
     out = capsys.readouterr().out
-    assert out.startswith("plan benchmark: 6 cells") and out.count("-orca-state-ppo-seed") == 6
+    assert out.startswith("plan benchmark: 6 cells of its 80 (--only), env steps per cell as listed")
+    assert out.count("-orca-state-ppo-seed") == 6
     assert "bounce-shadow" not in out and "6 left" in out
     assert (
         main(["olympiad", "benchmark", "--root", str(root), "--results", str(results), "--only", "baoding-ghost*"]) == 2
