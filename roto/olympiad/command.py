@@ -91,11 +91,11 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
 
     args.storage = resolve_storage(args.storage)
     plan = load_plan(args.plan)  # checked before anything runs or is written
-    select_cells(plan, args.only)  # a pattern that matches no cell stops here, before anything runs
     if args.threads is not None:
         if args.threads < 1:
             raise ValueError(f"--threads must be >= 1, got {args.threads}")
         plan = dataclasses.replace(plan, threads=args.threads)
+    chosen = select_cells(plan, args.only)  # a pattern that matches no cell stops here, before anything runs
     results = _results_dir(args, plan.name)
     if args.adopt:
         from roto.olympiad.adopt import adopt_cells
@@ -108,7 +108,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         if args.workers < 1:
             raise ValueError(f"--workers must be >= 1, got {args.workers}")
         whole = len(plan.cells) if args.only else None
-        print(dry_run_report(select_cells(plan, args.only), args.root, results, args.storage, args.workers, whole))
+        print(dry_run_report(chosen, args.root, results, args.storage, args.workers, whole))
         return 0
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
@@ -117,7 +117,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         study, storage = open_olympiad(plan, args.root, args.storage)
         if args.reclaim_now:  # here, once: a worker reclaiming would take its siblings' fresh claims
             reclaim_now(study, storage)
-        enqueue_missing(study, select_cells(plan, args.only), results)
+        enqueue_missing(study, chosen, results)
         argv = [
             args.plan,
             "--root",
