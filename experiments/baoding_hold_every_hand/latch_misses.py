@@ -31,7 +31,7 @@ from roto.eval.evaluate import EVAL_SEED, policy_groups
 from roto.rl.run_dir import load_policy
 from roto.tasks.baoding import baoding_rule, geometry_of
 from roto.tasks.pair_turns import pair_turns
-from roto.tasks.round_swaps import pair_turn_step
+from roto.tasks.round_swaps import centre_near_targets, pair_turn_step, turn_shaping
 
 RADII_CM = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0)
 CENTRE_SCALES = (1.0, 1.5, 2.0)
@@ -95,8 +95,6 @@ def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch
     steps, batch = path.shape[:2]
     angle = torch.zeros(batch, dtype=torch.float64)
     angle_set = torch.zeros(batch, dtype=torch.bool)
-    half = float((targets[0] - targets[1]).norm()) / 2
-    centre_offset = (path.double().mean(dim=2) - targets.mean(0)).norm(dim=-1)  # (T, B)
     total = torch.zeros(batch, dtype=torch.float64)
     near = {scale: torch.zeros(batch, dtype=torch.float64) for scale in CENTRE_SCALES}
     gated = {scale: torch.zeros(batch, dtype=torch.float64) for scale in CENTRE_SCALES}
@@ -104,12 +102,11 @@ def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch
         angle, turn = pair_turn_step(path[t].double(), angle, angle_set)
         angle_set = angle_set | True
         turn = torch.where(t < lengths, turn, 0.0)
-        grown = (total + turn).abs() - total.abs()  # what the turn shaping pays, in turns
-        total += turn
         for scale in CENTRE_SCALES:
-            inside = centre_offset[t] < scale * half
+            inside = centre_near_targets(path[t].double(), targets, scale)
             near[scale] += torch.where(inside, turn, 0.0)
-            gated[scale] += torch.where(inside | (grown < 0), grown, 0.0)
+            gated[scale] += turn_shaping(total, turn, 1.0, math.inf, math.inf, inside)[0]  # the aid's pay, in turns
+        total += turn
     row = {"plane turns": float(total.abs().mean())}
     row |= {f"near {scale:g}x": float(value.abs().mean()) for scale, value in near.items()}
     return row | {f"gated {scale:g}x": float(value.mean()) for scale, value in gated.items()}
@@ -153,9 +150,8 @@ def recount(checkpoint: str, episodes: int) -> tuple[str, dict[str, float]]:
     row = {"rotations": float(result["rotations"][:, 0].mean()), "net_turns": sum(net) / len(net)}
     for radius in RADII_CM:
         row[f"r={radius:g} cm"] = float(recounted_rotations(path, lengths, targets, radius / 100).mean())
-    return spec.env.robot, row | path_offsets(path, lengths, targets) | turns_near_targets(
-        path, lengths, targets
-    ) | turns_about_midpoint(path, lengths, targets)
+    where = path_offsets(path, lengths, targets) | turns_near_targets(path, lengths, targets)
+    return spec.env.robot, row | where | turns_about_midpoint(path, lengths, targets)
 
 
 def main() -> None:
