@@ -683,3 +683,14 @@ def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_
         recipe = blind_baoding("shadow", ROUND_BANK, pin, plan.steps, seed=cell.seed)
         differences = cell_spec(plan, cell).differences(recipe)
         assert differences == {"env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": True, "after": after}, None)}
+
+
+def test_the_turn_pay_study_is_baoding_cpu_with_only_its_turn_shaping_doubled():
+    """experiments/baoding_turn_pay pairs each seed with baoding_hold_start's run of baoding_cpu."""
+    from roto.olympiad.cell import cell_spec
+
+    plan = plan_named("turn_pay")
+    assert [(c.robot, c.seed) for c in plan.cells] == [("shadow", s) for s in range(5)]
+    for cell in plan.cells:
+        recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps, seed=cell.seed)
+        assert cell_spec(plan, cell).differences(recipe) == {"env.aids.turn_shaping.per_turn": (40.0, 20.0)}
