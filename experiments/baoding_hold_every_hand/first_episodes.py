@@ -1,13 +1,15 @@
 """How long an untrained policy's first training episodes last, per hand and seed, with and
-without the hold-pose start: one episode in each of 128 training envs of a fresh ``baoding_cpu``
-trainer (its aids on, its policy std), nothing learned.
+without the hold-pose start: one episode in each of 128 training envs of a fresh trainer of the
+config (its aids on, its policy std), nothing learned.
 
     python experiments/baoding_hold_every_hand/first_episodes.py [robot ...]
+    python experiments/baoding_hold_every_hand/first_episodes.py --task bounce --obs state \
+        --agent_cfg bounce_cpu_quickstart [robot ...]
 
 Prints one line per (robot, start): the seeds' mean first-episode lengths in control steps.
 """
 
-import sys
+import argparse
 import tempfile
 
 import torch
@@ -19,24 +21,30 @@ from roto.rl.runner import Trainer
 SEEDS = range(5)
 
 
-def first_episode_length(robot: str, seed: int, hold: bool) -> float:
+def first_episode_length(task: str, robot: str, obs: str, agent_cfg: str, seed: int, hold: bool) -> float:
     """Mean over the training envs of the first episode's length (steps) of a fresh trainer."""
     overrides = [f"network.start_at_hold={str(hold).lower()}"]
-    spec = build_run_spec("baoding", robot, "blind", "baoding_cpu", overrides, 1, num_envs=128, threads=1, seed=seed)
+    spec = build_run_spec(task, robot, obs, agent_cfg, overrides, 1, num_envs=128, threads=1, seed=seed)
     with tempfile.TemporaryDirectory() as run_dir, Trainer(spec, run_dir, tensorboard=False) as trainer:
         obs, _ = trainer.env.reset(seed=seed)
         with torch.no_grad():
             return float(first_episodes(trainer.env, trainer.alg.act, obs)["length"].mean())
 
 
-def main(robots: list[str]) -> None:
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("robots", nargs="*", default=["shadow", "shadow_lite", "allegro", "orca"])
+    parser.add_argument("--task", default="baoding")
+    parser.add_argument("--obs", default="blind")
+    parser.add_argument("--agent_cfg", default="baoding_cpu")
+    args = parser.parse_args()
     torch.set_num_threads(1)
-    for robot in robots:
+    for robot in args.robots:
         for hold in (False, True):
-            lengths = [first_episode_length(robot, seed, hold) for seed in SEEDS]
+            lengths = [first_episode_length(args.task, robot, args.obs, args.agent_cfg, s, hold) for s in SEEDS]
             shown = ", ".join(f"{value:.0f}" for value in lengths)
             print(f"{robot:12s} start_at_hold={hold!s:5s} first episodes by seed {list(SEEDS)}: {shown}", flush=True)
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or ["shadow", "shadow_lite", "allegro", "orca"])
+    main()
