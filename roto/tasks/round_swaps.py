@@ -98,9 +98,24 @@ def turn_shaping(
     return turn_reward * where(paid_here | (grown < 0), grown, 0.0), net
 
 
+def centre_offset(ball_pos: Array, targets: Array) -> Array:
+    """How far the pair's centre is from the targets' midpoint, in half the targets' separation
+    (pure; torch or numpy).
+
+    Args:
+        ball_pos: (B, 2, 3) ball centres, task frame.
+        targets: (2, 3) the two targets.
+
+    Returns:
+        (B,) float.
+    """
+    half = vector_norm(targets[0] - targets[1]) / 2.0
+    return vector_norm((ball_pos[:, 0] + ball_pos[:, 1]) / 2.0 - (targets[0] + targets[1]) / 2.0) / half
+
+
 def centre_near_targets(ball_pos: Array, targets: Array, near: float | Array) -> Array:
     """Whether the pair's centre is within ``near`` times half the targets' separation of their
-    midpoint (pure; torch or numpy).
+    midpoint (``centre_offset`` below ``near``; pure; torch or numpy).
 
     Args:
         ball_pos: (B, 2, 3) ball centres, task frame.
@@ -110,6 +125,4 @@ def centre_near_targets(ball_pos: Array, targets: Array, near: float | Array) ->
     Returns:
         (B,) bool.
     """
-    half = vector_norm(targets[0] - targets[1]) / 2.0
-    offset = vector_norm((ball_pos[:, 0] + ball_pos[:, 1]) / 2.0 - (targets[0] + targets[1]) / 2.0)
-    return offset < near * half
+    return centre_offset(ball_pos, targets) < near

@@ -13,7 +13,7 @@ from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
 from roto.tasks.baoding import Baoding, geometry_of
 from roto.tasks.base import TaskInputs
-from roto.tasks.round_swaps import centre_near_targets, turn_shaping
+from roto.tasks.round_swaps import centre_near_targets, centre_offset, turn_shaping
 from tests.tasks.test_round_swaps import SHADOW, path_round_the_targets
 
 
@@ -96,6 +96,8 @@ def test_the_pairs_centre_is_near_within_that_many_half_target_separations_of_th
     assert centre_near_targets(shifted, targets, 1.5).tolist() == [True, True, False]
     assert centre_near_targets(shifted, targets, 2.0).tolist() == [True, True, True]
     assert centre_near_targets(shifted.numpy(), targets.numpy(), 1.5).tolist() == [True, True, False]
+    assert centre_offset(shifted, targets).tolist() == pytest.approx([0.0, 1.4, 1.6], abs=1e-9)
+    assert centre_offset(shifted.numpy(), targets.numpy()).tolist() == pytest.approx([0.0, 1.4, 1.6], abs=1e-9)
 
 
 def test_paid_only_near_the_targets_turning_off_them_earns_nothing_and_no_loop_in_and_out_earns():
