@@ -31,7 +31,7 @@ from roto.eval.evaluate import EVAL_SEED, policy_groups
 from roto.rl.run_dir import load_policy
 from roto.tasks.baoding import baoding_rule, geometry_of
 from roto.tasks.pair_turns import pair_turns
-from roto.tasks.round_swaps import centre_offset, pair_turn_step, turn_shaping
+from roto.tasks.round_swaps import centre_offset, pair_turn_step, turn_pay_share, turn_shaping
 
 RADII_CM = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0)
 CENTRE_SCALES = (1.0, 1.5, 2.0)
@@ -88,7 +88,7 @@ def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch
     would pay, in turns ("gated"): the growth of the pair's net turning made inside, less every
     shrinking of it wherever it happens (so no loop, in and out, earns anything); and what it would
     pay with the growth outside paid at the share (scale / centre offset)² instead of nothing
-    ("soft": pay falling off with the centre's distance, so turning nearer always pays more).
+    ("soft", ``turn_shaping.soft``: pay falling off with the centre's distance).
 
     Args:
         path: (T, B, 2, 3) balls a and b at each step, task frame; lengths: (B,) each episode's steps;
@@ -106,13 +106,11 @@ def turns_near_targets(path: torch.Tensor, lengths: torch.Tensor, targets: torch
         angle_set = angle_set | True
         turn = torch.where(t < lengths, turn, 0.0)
         offset = centre_offset(path[t].double(), targets)  # half target separations
-        grown = turn_shaping(total, turn, 1.0, math.inf, math.inf)[0]  # the ungated pay, in turns
         for scale in CENTRE_SCALES:
-            inside = offset < scale
-            near[scale] += torch.where(inside, turn, 0.0)
-            gated[scale] += turn_shaping(total, turn, 1.0, math.inf, math.inf, inside)[0]  # the aid's pay, in turns
-            share = (scale / offset.clamp(min=1e-9)).square().clamp(max=1.0)
-            soft[scale] += torch.where(grown < 0, grown, share * grown)
+            near[scale] += torch.where(offset < scale, turn, 0.0)
+            for pay, fall_off in ((gated, 0.0), (soft, 1.0)):  # the aid's pay, in turns
+                share = turn_pay_share(path[t].double(), targets, scale, fall_off)
+                pay[scale] += turn_shaping(total, turn, 1.0, math.inf, math.inf, share)[0]
         total += turn
     row = {"plane turns": float(total.abs().mean())}
     row |= {f"near {scale:g}x": float(value.abs().mean()) for scale, value in near.items()}

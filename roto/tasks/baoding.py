@@ -24,7 +24,7 @@ from roto.tasks.base import (
     uniform,
 )
 from roto.tasks.pair_turns import pair_turns
-from roto.tasks.round_swaps import centre_near_targets, paid_swaps, pair_turn_step, turn_shaping
+from roto.tasks.round_swaps import paid_swaps, pair_turn_step, turn_pay_share, turn_shaping
 
 BALL_MASS = 0.055
 SUCCESS_RADIUS = 0.01
@@ -38,6 +38,7 @@ PARAMETER_FIELDS = MappingProxyType(
         "turn_reward": "turn_reward",
         "turn_lead": "turn_lead",
         "turn_near": "turn_near",
+        "turn_soft": "turn_soft",
     }
 )
 """{task parameter: the ``BaodingState`` field that holds it}."""
@@ -153,6 +154,7 @@ class BaodingState:
     turn_reward: torch.Tensor  # () float64: reward per turn the pair's net turning grows by
     turn_lead: torch.Tensor  # () float64: turns the paid turning may run ahead of half a turn per swap
     turn_near: torch.Tensor  # () float64: turning pays with the pair's centre this many half target separations near
+    turn_soft: torch.Tensor  # () float64: > 0: beyond turn_near the pay falls off as (near / offset)²
 
 
 def baoding_rule(
@@ -194,8 +196,8 @@ def follow_turns(state: BaodingState, pos: Array, swap: Array) -> dict[str, Arra
     )
     paid_turns = state.turn_lead + 0.5 * as_dtype_of(state.swaps, pos)  # turns the swaps so far back
     before = paid_turns - 0.5 * as_dtype_of(swap, pos)  # the bound before this step's swap
-    here = centre_near_targets(pos, state.targets, state.turn_near)
-    shaped, state.net_turn = turn_shaping(state.net_turn, turn, state.turn_reward, before, paid_turns, here)
+    share = turn_pay_share(pos, state.targets, state.turn_near, state.turn_soft)
+    shaped, state.net_turn = turn_shaping(state.net_turn, turn, state.turn_reward, before, paid_turns, share)
     return {"swap": paid, "turn": shaped}
 
 
@@ -217,6 +219,7 @@ class Baoding:
             "turn_reward": 0.0,
             "turn_lead": UNBOUNDED_LEAD,
             "turn_near": ANYWHERE,
+            "turn_soft": 0.0,
         }
     )
     """What training aids may change: the latch radius (m; a tolerance curriculum starts it wider,
@@ -224,8 +227,9 @@ class Baoding:
     round-swaps aid sets it, ``roto.tasks.round_swaps``), whether an episode's first swap is paid
     without them (0: no; the same aid), the reward per turn of the pair's net turning (0: none; the
     turn-shaping aid sets it, ``roto.tasks.round_swaps.turn_shaping``), the turns that paid turning
-    may run ahead of half a turn per swap (unbounded unless the aid's ``lead`` says) and how near
-    the targets the pair's centre must be for turning to pay (anywhere unless its ``near`` says)."""
+    may run ahead of half a turn per swap (unbounded unless the aid's ``lead`` says), how near
+    the targets the pair's centre must be for turning to pay (anywhere unless its ``near`` says) and
+    whether beyond that the pay falls off instead of stopping (its ``soft``)."""
     reference_name = "reference controller"
 
     @property
@@ -269,11 +273,12 @@ class Baoding:
             turn_reward=torch.zeros((), dtype=torch.float64, device=device),
             turn_lead=torch.tensor(UNBOUNDED_LEAD, dtype=torch.float64, device=device),
             turn_near=torch.tensor(ANYWHERE, dtype=torch.float64, device=device),
+            turn_soft=torch.zeros((), dtype=torch.float64, device=device),
         )
 
     def set_parameter(self, state: BaodingState, name: str, value: float | torch.Tensor) -> None:
         """Set ``success_radius``, ``swap_min_turn``, ``swap_first_paid``, ``turn_reward``,
-        ``turn_lead`` or ``turn_near`` of every world (``Task.set_parameter``)."""
+        ``turn_lead``, ``turn_near`` or ``turn_soft`` of every world (``Task.set_parameter``)."""
         set_state_parameter(state, PARAMETER_FIELDS, name, value)
 
     def reset(self, state: BaodingState, mask: torch.Tensor) -> None:

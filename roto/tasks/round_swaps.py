@@ -68,7 +68,7 @@ def turn_shaping(
     turn_reward: float | Array,
     cap: Array | float,
     new_cap: Array | float,
-    paid_here: Array | bool = True,
+    share: Array | float = 1.0,
 ) -> tuple[Array, Array]:
     """The turn-shaping reward: ``turn_reward`` per turn the pair's paid turning grows (pure; torch
     or numpy).
@@ -85,17 +85,18 @@ def turn_shaping(
         turn: (B,) signed turns this step (``pair_turn_step``).
         turn_reward: reward per turn (0: the benchmark, nothing paid).
         cap, new_cap: (B,) the paid turning's bound before and after this step.
-        paid_here: (B,) bool, or True everywhere: where False (Baoding: the pair's centre away from
-            the targets, ``centre_near_targets``) growth is not paid but shrinking is still charged.
-            Then the term is no longer potential-based, but no closed loop earns anything: a turn
-            out there and back here, or here and back there, sums to at most 0.
+        share: (B,) the share of this step's growth that is paid (bool or float in [0, 1]; Baoding:
+            ``turn_pay_share``, lower with the pair's centre away from the targets); shrinking is
+            charged in full wherever it happens. Below 1 the term is no longer potential-based, but
+            no closed loop earns anything: a turn made at a lower share and undone at a higher one,
+            or the reverse, sums to at most 0.
 
     Returns:
         (reward (B,), new net_turn (B,))
     """
     net = net_turn + turn
     grown = minimum(abs(net), new_cap) - minimum(abs(net_turn), cap)
-    return turn_reward * where(paid_here | (grown < 0), grown, 0.0), net
+    return turn_reward * where(grown < 0, grown, share * grown), net
 
 
 def centre_offset(ball_pos: Array, targets: Array) -> Array:
@@ -126,3 +127,23 @@ def centre_near_targets(ball_pos: Array, targets: Array, near: float | Array) ->
         (B,) bool.
     """
     return centre_offset(ball_pos, targets) < near
+
+
+def turn_pay_share(ball_pos: Array, targets: Array, near: float | Array, soft: float | Array = 0.0) -> Array:
+    """The share of the pair's turning that turn shaping pays, by where the pair is (pure; torch or
+    numpy): 1 with its centre within ``near`` half target separations of the targets' midpoint
+    (``centre_offset``); beyond, nothing, or with ``soft`` > 0 (near / offset)², so that turning
+    the pair nearer the targets always pays more and turning it anywhere pays something.
+
+    Args:
+        ball_pos: (B, 2, 3) ball centres, task frame.
+        targets: (2, 3) the two targets.
+        near: half target separations (large: everywhere).
+        soft: > 0: the share falls off beyond ``near``; 0: it drops to 0 there.
+
+    Returns:
+        (B,) float in [0, 1].
+    """
+    offset = centre_offset(ball_pos, targets)
+    falling = (soft > 0) * (near / where(offset > 0, offset, 1.0)) ** 2  # soft: a bool or a () tensor
+    return where(offset < near, 1.0, falling)

@@ -13,7 +13,7 @@ from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
 from roto.tasks.baoding import Baoding, geometry_of
 from roto.tasks.base import TaskInputs
-from roto.tasks.round_swaps import centre_near_targets, centre_offset, turn_shaping
+from roto.tasks.round_swaps import centre_near_targets, centre_offset, turn_pay_share, turn_shaping
 from tests.tasks.test_round_swaps import SHADOW, path_round_the_targets
 
 
@@ -32,7 +32,7 @@ def test_the_shaping_pays_growth_of_the_net_turning_and_takes_it_back_as_it_shri
     assert float(reward[0]) == pytest.approx(1.0)
 
 
-def shaped_rewards(path, turn_reward, lead=None, near=None):
+def shaped_rewards(path, turn_reward, lead=None, near=None, soft=False):
     """(sum of the "turn" term over ``path``, the terms' names) of one Baoding world."""
     task = Baoding()
     state = task.init_state(SHADOW, 1, torch.device("cpu"))
@@ -41,6 +41,8 @@ def shaped_rewards(path, turn_reward, lead=None, near=None):
         task.set_parameter(state, "turn_lead", lead)
     if near is not None:
         task.set_parameter(state, "turn_near", near)
+    if soft:
+        task.set_parameter(state, "turn_soft", 1.0)
     total, names = 0.0, set()
     for pos in path:
         inputs = TaskInputs(
@@ -100,6 +102,23 @@ def test_the_pairs_centre_is_near_within_that_many_half_target_separations_of_th
     assert centre_offset(shifted.numpy(), targets.numpy()).tolist() == pytest.approx([0.0, 1.4, 1.6], abs=1e-9)
 
 
+def test_the_share_paid_is_whole_near_the_targets_and_beyond_nothing_or_falling_off_with_the_square():
+    targets = torch.tensor(geometry_of(SHADOW).targets, dtype=torch.float64)
+    half = float((targets[0] - targets[1]).norm()) / 2
+    pair = path_round_the_targets([0.5 * math.pi])[0]
+    offsets = (0.0, 1.4, 1.6, 3.0)
+    shifted = torch.stack([pair + torch.tensor([0.0, 0.0, k * half], dtype=torch.float64) for k in offsets])
+    assert turn_pay_share(shifted, targets, 1.5).tolist() == [1.0, 1.0, 0.0, 0.0]
+    soft = [1.0, 1.0, (1.5 / 1.6) ** 2, 0.25]
+    assert turn_pay_share(shifted, targets, 1.5, 1.0).tolist() == pytest.approx(soft)
+    assert turn_pay_share(shifted.numpy(), targets.numpy(), 1.5, 1.0).tolist() == pytest.approx(soft)
+    assert turn_pay_share(shifted, targets, 1e9, 1.0).tolist() == [1.0] * 4  # the task's default: anywhere
+    assert turn_pay_share(shifted[:1], targets, 0.0, 1.0).tolist() == [0.0]  # near 0 at the midpoint: no 0 / 0
+    net, turn = torch.tensor([0.3, 0.3]), torch.tensor([0.1, -0.1])
+    reward, _ = turn_shaping(net, turn, 20.0, math.inf, math.inf, torch.tensor([0.25, 0.25]))
+    assert reward.tolist() == pytest.approx([0.5, -2.0])  # growth paid at the share, shrinking in full
+
+
 def test_paid_only_near_the_targets_turning_off_them_earns_nothing_and_no_loop_in_and_out_earns():
     round_path = path_round_the_targets(np.linspace(0.5 * math.pi, 4.5 * math.pi, 121))  # two turns
     assert shaped_rewards(round_path, 20.0, near=1.5)[0] == pytest.approx(40.0)  # round the targets: all paid
@@ -116,6 +135,22 @@ def test_paid_only_near_the_targets_turning_off_them_earns_nothing_and_no_loop_i
     assert shaped_rewards(reverse, 20.0, near=1.5)[0] == pytest.approx(-30.0)
 
 
+def test_falling_off_turning_off_the_targets_earns_less_and_no_loop_in_and_out_earns():
+    round_path = path_round_the_targets(np.linspace(0.5 * math.pi, 4.5 * math.pi, 121))  # two turns
+    assert shaped_rewards(round_path, 20.0, near=1.5, soft=True)[0] == pytest.approx(40.0)
+    spun = round_path + torch.tensor([0.0, 0.05, 0.0], dtype=torch.float64)  # about 2.5 half separations off
+    targets = torch.tensor(geometry_of(SHADOW).targets, dtype=torch.float64)
+    share = (1.5 / (0.05 / (float((targets[0] - targets[1]).norm()) / 2))) ** 2  # (near / offset)²
+    assert shaped_rewards(spun, 20.0, near=1.5, soft=True)[0] == pytest.approx(40.0 * share)
+    assert shaped_rewards(spun, 20.0, near=1.5, soft=True)[0] < shaped_rewards(spun, 20.0, near=2.0, soft=True)[0]
+    half_turn = path_round_the_targets(np.linspace(0.5 * math.pi, 1.5 * math.pi, 31))
+    off = torch.tensor([0.0, 0.05, 0.0], dtype=torch.float64)
+    loop = torch.cat([half_turn, half_turn.flip(0) + off] * 3)  # out here, back off the targets, thrice
+    assert shaped_rewards(loop, 20.0, near=1.5, soft=True)[0] == pytest.approx(0.0, abs=1e-9)
+    reverse = torch.cat([half_turn + off, half_turn.flip(0)] * 3)  # out off the targets, back here
+    assert shaped_rewards(reverse, 20.0, near=1.5, soft=True)[0] == pytest.approx(3 * (10.0 * share - 10.0))
+
+
 def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     env = roto.make("baoding", robot="shadow", num_envs=2, seed=0, aids={"turn_shaping": {"per_turn": 20.0}})
     assert float(env.task_state.turn_reward) == 20.0 and [type(a).__name__ for a in env.aids] == ["TurnShaping"]
@@ -129,6 +164,9 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     assert float(bounded.task_state.turn_lead) == 0.5 and float(env.task_state.turn_lead) == 1e9
     near = roto.make("baoding", num_envs=1, aids={"turn_shaping": {"per_turn": 20.0, "near": 1.5}})
     assert float(near.task_state.turn_near) == 1.5 and float(env.task_state.turn_near) == 1e9
+    assert float(near.task_state.turn_soft) == 0.0
+    soft = roto.make("baoding", num_envs=1, aids={"turn_shaping": {"per_turn": 20.0, "near": 1.5, "soft": True}})
+    assert float(soft.task_state.turn_soft) == 1.0 and float(soft.task_state.turn_near) == 1.5
 
 
 @pytest.mark.parametrize(
@@ -141,6 +179,8 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
         ("baoding", {"lead": -1.0}, r"aids.turn_shaping.lead must be a number of turns.*got -1.0"),
         ("baoding", {"near": -1.5}, r"aids.turn_shaping.near must be a number of half target separations.*got -1.5"),
         ("baoding", {"near": "far"}, r"aids.turn_shaping.near must be .*got 'far'"),
+        ("baoding", {"near": 1.5, "soft": "yes"}, r"aids.turn_shaping.soft must be true or false, got 'yes'"),
+        ("baoding", {"soft": True}, r"aids.turn_shaping.soft needs aids.turn_shaping.near .*got near=None"),
     ],
 )
 def test_bad_turn_reward_is_refused(task, per_turn, pattern):

@@ -140,11 +140,15 @@ class TurnShapingSettings:
             centre is within ``near`` times half the targets' separation of their midpoint (a
             length each hand's targets give), and shrinking it is charged anywhere, so turning the
             pair off the targets earns nothing and no loop, in and out, earns anything.
+        soft: with ``near``: beyond it the turning pays (near / offset)² of its reward (offset: the
+            centre's distance from the midpoint in half separations) instead of nothing, so turning
+            nearer the targets always pays more; shrinking is still charged in full anywhere.
     """
 
     per_turn: float = 20.0
     lead: float | None = None
     near: float | None = None
+    soft: bool = False
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "turn_reward", "a ball pair")
@@ -153,6 +157,12 @@ class TurnShapingSettings:
             _number(f"{path}.lead", self.lead, 0.0, 100.0, "a number of turns (or null: unbounded)")
         if self.near is not None:
             _number(f"{path}.near", self.near, 0.0, 100.0, "a number of half target separations (or null: anywhere)")
+        if not isinstance(self.soft, bool):
+            raise ValueError(f"{path}.soft must be true or false, got {self.soft!r}")
+        if self.soft and self.near is None:
+            raise ValueError(
+                f"{path}.soft needs {path}.near (the half target separations it falls off beyond), got near=None"
+            )
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -1,8 +1,8 @@
 """The turn-shaping aid: a training env earns ``TurnShapingSettings.per_turn`` per turn the pair's net
 turning this episode grows, and gives it back as it shrinks (``roto.tasks.round_swaps.turn_shaping``),
 so carrying the balls round pays and swinging them out and back does not. It only sets the task's
-``turn_reward`` parameter (and with ``lead`` or ``near`` its ``turn_lead`` or ``turn_near``); the
-task does the rest (a "turn" reward term)."""
+``turn_reward`` parameter (and with ``lead``, ``near`` or ``soft`` its ``turn_lead``, ``turn_near``
+or ``turn_soft``); the task does the rest (a "turn" reward term)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from roto.envs.aids.settings import TurnShapingSettings
 
 
 class TurnShaping(TrainingAid):
-    """Sets the task parameters ``turn_reward`` (and ``turn_lead``, ``turn_near``) once, when the env
+    """Sets the task parameters ``turn_reward`` (and ``turn_lead``, ``turn_near``, ``turn_soft``) once, when the env
     is built."""
 
     def __init__(self, host: AidHost, settings: TurnShapingSettings) -> None:
@@ -20,3 +20,5 @@ class TurnShaping(TrainingAid):
             host.task.set_parameter(host.task_state, "turn_lead", settings.lead)
         if settings.near is not None:  # else the task's own: anywhere
             host.task.set_parameter(host.task_state, "turn_near", settings.near)
+        if settings.soft:  # else the task's own: no pay beyond near
+            host.task.set_parameter(host.task_state, "turn_soft", 1.0)
