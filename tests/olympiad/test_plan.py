@@ -24,6 +24,10 @@ def earlier(hand: str) -> str:
     return str(EARLIER_CONFIGS / f"baoding_cpu_{hand}.yaml")
 
 
+TURN_SHAPING = {"per_turn": 20, "lead": None, "near": None, "soft": False}
+"""baoding_cpu's turn shaping, every setting."""
+
+
 def plan_named(name: str):
     """A packaged plan, or an experiment's by its file's name."""
     return load_plan(str(EXPERIMENT_PLANS[name]) if name in EXPERIMENT_PLANS else name)
@@ -453,7 +457,7 @@ def test_the_shadows_round_plan_is_its_recipe_with_the_round_bank_and_round_swap
     assert cell_spec(plan, plan.cells[0]).differences(recipe) == {
         "env.aids.replayed_starts.bank": (round_bank, recipe.env.aids.replayed_starts.bank),
         "env.aids.round_swaps": ({"min_turn": 0.25, "first_paid": False, "after": None}, None),
-        "env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None, "near": None}),  # the recipe's since it ran
+        "env.aids.turn_shaping": (None, TURN_SHAPING),  # the recipe's since it ran
         "env.seed": (3, 0),
     }  # fmt: skip
     assert round_bank in packaged_banks()
@@ -630,7 +634,7 @@ def test_each_part_of_baoding_cpu_is_switched_off_by_exactly_one_ablation():
     replayed = {"bank": "shadow_round_preswap", "share": 0.5, "record_lead": 10, "record_capacity": 1024}
     expected = {
         "no_round_swaps": {"env.aids.round_swaps": (None, {"min_turn": 0.25, "first_paid": True, "after": 2})},
-        "no_turn_shaping": {"env.aids.turn_shaping": (None, {"per_turn": 20, "lead": None, "near": None})},
+        "no_turn_shaping": {"env.aids.turn_shaping": (None, TURN_SHAPING)},
         "no_replayed_starts": {"env.aids.replayed_starts": (None, replayed)},
         "no_recording": {"env.aids.replayed_starts.record_lead": (0, 10)},
         "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2})},
@@ -694,3 +698,17 @@ def test_the_turn_pay_study_is_baoding_cpu_with_only_its_turn_shaping_doubled():
     for cell in plan.cells:
         recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps, seed=cell.seed)
         assert cell_spec(plan, cell).differences(recipe) == {"env.aids.turn_shaping.per_turn": (40.0, 20.0)}
+
+
+def test_the_turn_soft_probe_is_the_allegros_baoding_cpu_cells_with_only_its_turn_shaping_falling_off():
+    """experiments/baoding_turn_soft probes the Allegro's seeds 1 and 3, which baoding_cpu left off the targets."""
+    from roto.olympiad.cell import cell_spec
+
+    plan = plan_named("turn_soft")
+    assert [(c.robot, c.seed) for c in plan.cells] == [("allegro", 1), ("allegro", 3)] and plan.steps == 10_000_000
+    for cell in plan.cells:
+        recipe = blind_baoding("allegro", "baoding_cpu", steps=plan.steps, seed=cell.seed)
+        assert cell_spec(plan, cell).differences(recipe) == {
+            "env.aids.turn_shaping.near": (1.0, None),
+            "env.aids.turn_shaping.soft": (True, False),
+        }
