@@ -114,21 +114,6 @@ def centre_offset(ball_pos: Array, targets: Array) -> Array:
     return vector_norm((ball_pos[:, 0] + ball_pos[:, 1]) / 2.0 - (targets[0] + targets[1]) / 2.0) / half
 
 
-def centre_near_targets(ball_pos: Array, targets: Array, near: float | Array) -> Array:
-    """Whether the pair's centre is within ``near`` times half the targets' separation of their
-    midpoint (``centre_offset`` below ``near``; pure; torch or numpy).
-
-    Args:
-        ball_pos: (B, 2, 3) ball centres, task frame.
-        targets: (2, 3) the two targets.
-        near: half target separations (large: everywhere).
-
-    Returns:
-        (B,) bool.
-    """
-    return centre_offset(ball_pos, targets) < near
-
-
 def turn_pay_share(ball_pos: Array, targets: Array, near: float | Array, soft: float | Array = 0.0) -> Array:
     """The share of the pair's turning that turn shaping pays, by where the pair is (pure; torch or
     numpy): 1 with its centre within ``near`` half target separations of the targets' midpoint

@@ -13,7 +13,7 @@ from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
 from roto.tasks.baoding import Baoding, geometry_of
 from roto.tasks.base import TaskInputs
-from roto.tasks.round_swaps import centre_near_targets, centre_offset, turn_pay_share, turn_shaping
+from roto.tasks.round_swaps import centre_offset, turn_pay_share, turn_shaping
 from tests.tasks.test_round_swaps import SHADOW, path_round_the_targets
 
 
@@ -95,9 +95,9 @@ def test_the_pairs_centre_is_near_within_that_many_half_target_separations_of_th
     half = float((targets[0] - targets[1]).norm()) / 2
     pair = path_round_the_targets([0.5 * math.pi])[0]  # centred on the targets' midpoint
     shifted = torch.stack([pair + torch.tensor([0.0, 0.0, k * half], dtype=torch.float64) for k in (0.0, 1.4, 1.6)])
-    assert centre_near_targets(shifted, targets, 1.5).tolist() == [True, True, False]
-    assert centre_near_targets(shifted, targets, 2.0).tolist() == [True, True, True]
-    assert centre_near_targets(shifted.numpy(), targets.numpy(), 1.5).tolist() == [True, True, False]
+    assert turn_pay_share(shifted, targets, 1.5).tolist() == [1.0, 1.0, 0.0]
+    assert turn_pay_share(shifted, targets, 2.0).tolist() == [1.0, 1.0, 1.0]
+    assert turn_pay_share(shifted.numpy(), targets.numpy(), 1.5).tolist() == [1.0, 1.0, 0.0]
     assert centre_offset(shifted, targets).tolist() == pytest.approx([0.0, 1.4, 1.6], abs=1e-9)
     assert centre_offset(shifted.numpy(), targets.numpy()).tolist() == pytest.approx([0.0, 1.4, 1.6], abs=1e-9)
 
