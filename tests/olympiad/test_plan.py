@@ -536,36 +536,34 @@ def test_baoding_cpu_is_the_armed_recipe_started_at_the_hold_pose_as_the_studies
             assert cell_spec(study, cell).differences(blind_baoding(cell.robot, earlier("armed"), seed=cell.seed)) == {}
 
 
-def test_the_hold_start_study_is_baoding_cpu():
-    """experiments/baoding_hold_start trained today's baoding_cpu, seeds 0-9 of the blind Shadow."""
+def assert_baoding_cpu_cells_but(name: str, cells: list[tuple[str, int]], differences: dict):
+    """Plan ``name`` holds exactly ``cells`` ((robot, seed), in order), each the blind Baoding cell of
+    ``baoding_cpu`` on that hand and seed at the plan's budget but for ``differences``; the plan."""
     from roto.olympiad.cell import cell_spec
 
-    plan = plan_named("hold_start")
-    assert [(c.robot, c.seed) for c in plan.cells] == [("shadow", s) for s in range(10)]
+    plan = plan_named(name)
+    assert [(c.robot, c.seed) for c in plan.cells] == cells
     for cell in plan.cells:
-        recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps, seed=cell.seed)
-        assert cell_spec(plan, cell).differences(recipe) == {}
+        recipe = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps, seed=cell.seed)
+        assert cell_spec(plan, cell).differences(recipe) == differences
+    return plan
+
+
+def test_the_hold_start_study_is_baoding_cpu():
+    """experiments/baoding_hold_start trained today's baoding_cpu, seeds 0-9 of the blind Shadow."""
+    assert_baoding_cpu_cells_but("hold_start", [("shadow", s) for s in range(10)], {})
 
 
 def test_the_kl_target_study_is_baoding_cpu_with_only_its_kl_target_doubled():
     """experiments/baoding_kl_target pairs each seed with baoding_hold_start's run of baoding_cpu."""
-    from roto.olympiad.cell import cell_spec
-
-    plan = plan_named("kl_target")
-    assert [(c.robot, c.seed) for c in plan.cells] == [("shadow", s) for s in range(5)]
-    for cell in plan.cells:
-        recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps, seed=cell.seed)
-        assert cell_spec(plan, cell).differences(recipe) == {"agent.ppo.kl_target": (0.016, 0.008)}
+    doubled = {"agent.ppo.kl_target": (0.016, 0.008)}
+    assert_baoding_cpu_cells_but("kl_target", [("shadow", s) for s in range(5)], doubled)
 
 
 def test_the_turn_near_probe_is_the_allegros_baoding_cpu_cell_with_only_its_turn_shaping_gated():
     """experiments/baoding_turn_near probes the Allegro's seed 1, which baoding_cpu left turning off the targets."""
-    from roto.olympiad.cell import cell_spec
-
-    plan = plan_named("turn_near")
+    plan = assert_baoding_cpu_cells_but("turn_near", [("allegro", 1)], {"env.aids.turn_shaping.near": (1.5, None)})
     assert [c.name for c in plan.cells] == ["baoding-allegro-blind-near_1_5-seed1"] and plan.steps == 10_000_000
-    recipe = blind_baoding("allegro", "baoding_cpu", steps=plan.steps, seed=1)
-    assert cell_spec(plan, plan.cells[0]).differences(recipe) == {"env.aids.turn_shaping.near": (1.5, None)}
 
 
 def test_the_every_hand_hold_study_trains_exactly_the_benchmarks_blind_baoding_cells_of_the_other_hands():
@@ -691,24 +689,12 @@ def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_
 
 def test_the_turn_pay_study_is_baoding_cpu_with_only_its_turn_shaping_doubled():
     """experiments/baoding_turn_pay pairs each seed with baoding_hold_start's run of baoding_cpu."""
-    from roto.olympiad.cell import cell_spec
-
-    plan = plan_named("turn_pay")
-    assert [(c.robot, c.seed) for c in plan.cells] == [("shadow", s) for s in range(5)]
-    for cell in plan.cells:
-        recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps, seed=cell.seed)
-        assert cell_spec(plan, cell).differences(recipe) == {"env.aids.turn_shaping.per_turn": (40.0, 20.0)}
+    doubled = {"env.aids.turn_shaping.per_turn": (40.0, 20.0)}
+    assert_baoding_cpu_cells_but("turn_pay", [("shadow", s) for s in range(5)], doubled)
 
 
 def test_the_turn_soft_probe_is_the_allegros_baoding_cpu_cells_with_only_its_turn_shaping_falling_off():
     """experiments/baoding_turn_soft probes the Allegro's seeds 1 and 3, which baoding_cpu left off the targets."""
-    from roto.olympiad.cell import cell_spec
-
-    plan = plan_named("turn_soft")
-    assert [(c.robot, c.seed) for c in plan.cells] == [("allegro", 1), ("allegro", 3)] and plan.steps == 10_000_000
-    for cell in plan.cells:
-        recipe = blind_baoding("allegro", "baoding_cpu", steps=plan.steps, seed=cell.seed)
-        assert cell_spec(plan, cell).differences(recipe) == {
-            "env.aids.turn_shaping.near": (1.0, None),
-            "env.aids.turn_shaping.soft": (True, False),
-        }
+    falling = {"env.aids.turn_shaping.near": (1.0, None), "env.aids.turn_shaping.soft": (True, False)}
+    plan = assert_baoding_cpu_cells_but("turn_soft", [("allegro", 1), ("allegro", 3)], falling)
+    assert plan.steps == 10_000_000
