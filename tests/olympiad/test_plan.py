@@ -698,3 +698,10 @@ def test_the_turn_soft_probe_is_the_allegros_baoding_cpu_cells_with_only_its_tur
     falling = {"env.aids.turn_shaping.near": (1.0, None), "env.aids.turn_shaping.soft": (True, False)}
     plan = assert_baoding_cpu_cells_but("turn_soft", [("allegro", 1), ("allegro", 3)], falling)
     assert plan.steps == 10_000_000
+
+
+def test_the_wide_latch_probe_is_the_allegros_baoding_cpu_cells_with_only_its_latch_starting_at_5_cm():
+    """experiments/baoding_wide_latch probes the Allegro's seeds 1 and 3, which baoding_cpu left off the targets."""
+    wide = {"env.aids.tolerance.start": (0.05, 0.025)}
+    plan = assert_baoding_cpu_cells_but("wide_latch", [("allegro", 1), ("allegro", 3)], wide)
+    assert plan.steps == 10_000_000
