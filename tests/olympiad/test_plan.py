@@ -1,3 +1,4 @@
+import dataclasses
 import json
 import pathlib
 
@@ -705,3 +706,12 @@ def test_the_wide_latch_probe_is_the_allegros_baoding_cpu_cells_with_only_its_la
     wide = {"env.aids.tolerance.start": (0.05, 0.025)}
     plan = assert_baoding_cpu_cells_but("wide_latch", [("allegro", 1), ("allegro", 3)], wide)
     assert plan.steps == 10_000_000
+
+
+def test_the_forward_dynamics_study_is_baoding_cpu_with_only_roto_s_memory_loss_added():
+    """experiments/baoding_forward_dynamics pairs each seed with baoding_hold_start's run of baoding_cpu."""
+    from roto.rl.ssl.configs import ForwardDynamicsMemoryConfig
+
+    loss = ForwardDynamicsMemoryConfig(weight=0.025, lr=2.5e-4, seq_length=2)
+    added = {"agent.ssl.forward_dynamics_memory": (json.loads(json.dumps(dataclasses.asdict(loss))), None)}
+    assert_baoding_cpu_cells_but("forward_dynamics", [("shadow", s) for s in range(5)], added)
