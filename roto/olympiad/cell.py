@@ -119,7 +119,8 @@ def run_cell(
         trainer.train(progress=False)
     final = copy.deepcopy(trainer.model).cpu().eval()
     best = copy.deepcopy(final)
-    best.load_state_dict(load_checkpoint(RunDir(run_dir).checkpoint("best"))["model"])
+    best_checkpoint = load_checkpoint(RunDir(run_dir).checkpoint("best"))
+    best.load_state_dict(best_checkpoint["model"])
     records = read_evaluations(run_dir)
     summary = {
         **format_stamp("cell summary"),
@@ -132,7 +133,7 @@ def run_cell(
         "run_dir": str(run_dir),
         "env_steps": trainer.env_steps,
         "train_wall_s": trainer.train_seconds,
-        "best_update": max(records, key=lambda r: r["return_mean"])["update"],
+        "best_update": best_checkpoint["update"],  # chosen by the task's selection metric, as best.pt
         "evaluations": [{k: v for k, v in r.items() if k != "per_episode"} for r in records],
         "training": training_curve(read_scalars(run_dir), [r["env_steps"] for r in records]),
         "final": evaluate(final, trainer.spec, plan.eval_episodes, env_factory=env_factory),

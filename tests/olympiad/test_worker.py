@@ -5,12 +5,14 @@ import signal
 import time
 
 import optuna
+import torch
 import yaml
 from optuna.trial import TrialState
 
 from roto.jobs.storage import REASON_ATTR, open_storage
 from roto.olympiad.plan import load_plan
 from roto.olympiad.worker import CELL_ATTR, cell_status, study_name
+from roto.rl.checkpoints import load_checkpoint
 from roto.rl.evaluation import read_evaluations
 from tests.olympiad.toy_plan import toy_worker, write_toy_plan
 
@@ -151,6 +153,22 @@ def test_a_finished_cell_whose_summary_is_taken_away_continues_to_the_plans_long
     for cell in plan.cells[1:]:
         assert json.loads((results / f"{cell.name}.json").read_text())["env_steps"] == 8 * 4 * 2
     assert set(cell_status(plan, str(root), results, None).values()) == {"done"}
+
+
+def test_a_summarys_best_update_is_the_update_best_pt_holds(tmp_path):
+    """Not the evaluation with the best return: Baoding chooses best.pt by round rotations."""
+    root = tmp_path / "runs"
+    plan = load_plan(str(write_toy_plan(tmp_path, updates=4, seeds=(0,))))
+    assert toy_worker(tmp_path / "toy.yaml", root) == len(plan.cells)
+    cell = plan.cells[0]
+    best_path = root / plan.name / cell.name / "checkpoints" / "best.pt"
+    best_pt = load_checkpoint(best_path)
+    records = read_evaluations(root / plan.name / cell.name)
+    other = next(r["update"] for r in records if r["update"] != best_pt["update"])
+    torch.save({**best_pt, "update": other}, best_path)  # as if another evaluation had been chosen
+    (root / plan.name / "results" / f"{cell.name}.json").unlink()
+    assert toy_worker(tmp_path / "toy.yaml", root) == 1
+    assert json.loads((root / plan.name / "results" / f"{cell.name}.json").read_text())["best_update"] == other
 
 
 def test_a_waiting_cell_no_longer_in_the_plan_is_failed_with_its_name(tmp_path):
