@@ -715,3 +715,16 @@ def test_the_forward_dynamics_study_is_baoding_cpu_with_only_roto_s_memory_loss_
     loss = ForwardDynamicsMemoryConfig(weight=0.025, lr=2.5e-4, seq_length=2)
     added = {"agent.ssl.forward_dynamics_memory": (json.loads(json.dumps(dataclasses.asdict(loss))), None)}
     assert_baoding_cpu_cells_but("forward_dynamics", [("shadow", s) for s in range(5)], added)
+
+
+def test_the_turn_soft_continuation_is_its_probes_cell_at_20_m():
+    """experiments/baoding_turn_soft/turn_soft_20m.yaml continues the probe's cells: the same names
+    and run specs but the budget, so a run directory copied over from there continues."""
+    from roto.olympiad.cell import cell_spec
+
+    probe, longer = plan_named("turn_soft"), plan_named("turn_soft_20m")
+    assert longer.steps == 2 * probe.steps == 20_000_000
+    for cell in longer.cells:
+        twin = next(c for c in probe.cells if c.name == cell.name)
+        mine, theirs = cell_spec(longer, cell), cell_spec(probe, twin)
+        assert mine.differences(theirs) == {} and (mine.steps, theirs.steps) == (20_000_000, 10_000_000)
