@@ -16,9 +16,13 @@ from tests.conftest import BAODING_AIDS, require_warp
 
 ARMED = {**BAODING_AIDS["aids"], "round_swaps": {"min_turn": 0.25, "first_paid": True, "after": 0.5}}
 """The recipe's aids with round swaps armed part way (an aid that follows the ended episodes)."""
+NARROWING = {**BAODING_AIDS["aids"], "turn_shaping": {"per_turn": 20.0, "near": 1.0, "soft": True, "near_from": 3.0}}
+"""The recipe's aids with turn shaping's near narrowing as the episodes turn the pair (another that follows them)."""
 
 
-@pytest.mark.parametrize("aids", [BAODING_AIDS["aids"], ARMED], ids=["aids", "armed_round_swaps"])
+@pytest.mark.parametrize(
+    "aids", [BAODING_AIDS["aids"], ARMED, NARROWING], ids=["aids", "armed_round_swaps", "narrowing_near"]
+)
 def test_rollouts_of_the_baoding_recipe_read_nothing_back(tmp_path, monkeypatch, host_reads, aids):
     require_warp()
     env = EnvConfig(

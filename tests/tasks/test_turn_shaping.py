@@ -9,6 +9,9 @@ import pytest
 import torch
 
 import roto
+from roto.envs.aids.episode_mean import EPISODE_WEIGHT
+from roto.envs.aids.protocol import StepContext
+from roto.envs.aids.turn_shaping import NarrowingTurnShaping
 from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
 from roto.tasks.baoding import Baoding, geometry_of
@@ -169,6 +172,33 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
     assert float(soft.task_state.turn_soft) == 1.0 and float(soft.task_state.turn_near) == 1.5
 
 
+NARROWING = {"turn_shaping": {"per_turn": 20.0, "near": 1.0, "soft": True, "near_from": 3.0, "near_turns": 2.0}}
+
+
+def test_a_narrowing_near_starts_wide_narrows_as_the_episodes_turn_the_pair_and_resumes_exactly():
+    env = roto.make("baoding", robot="shadow", num_envs=4, seed=0, aids=NARROWING)
+    shaping = env.aid(NarrowingTurnShaping)
+    assert float(env.task_state.turn_near) == 3.0 and float(env.task_state.turn_soft) == 1.0
+    env.reset()
+    env.task_state.net_turn.copy_(torch.tensor([-1.0, 1.0, 9.0, 1.0], dtype=torch.float64))  # either way round
+    ended = torch.tensor([True, True, False, True])  # the world still turning does not count
+    shaping.observe(StepContext(None, None, None, env.task_state, None, None, ended))
+    mean = 1.0 - (1.0 - EPISODE_WEIGHT) ** 3
+    assert float(env.task_state.turn_near) == pytest.approx(1.0 + 2.0 * (1.0 - mean / 2.0))
+    assert float(shaping.metrics()["train/turn_near"]) == pytest.approx(float(env.task_state.turn_near))
+    other = roto.make("baoding", robot="shadow", num_envs=4, seed=5, aids=NARROWING)
+    other.load_state_dict(env.state_dict())
+    assert torch.equal(other.task_state.turn_near, env.task_state.turn_near)
+    env.task_state.net_turn.fill_(2.0)
+    for _ in range(600):  # episodes that turn the pair near_turns: near itself
+        shaping.observe(StepContext(None, None, None, env.task_state, None, None, torch.ones(4, dtype=torch.bool)))
+    assert float(env.task_state.turn_near) == pytest.approx(1.0, abs=1e-6)
+    fixed = roto.make(
+        "baoding", robot="shadow", num_envs=4, seed=0, aids={"turn_shaping": {"per_turn": 20.0, "near": 1.0}}
+    )
+    assert fixed.aid(NarrowingTurnShaping) is None and [type(a).__name__ for a in fixed.aids] == ["TurnShaping"]
+
+
 @pytest.mark.parametrize(
     ("task", "per_turn", "pattern"),
     [
@@ -181,6 +211,9 @@ def test_an_env_sets_the_aid_from_its_config_and_evaluation_never_does():
         ("baoding", {"near": "far"}, r"aids.turn_shaping.near must be .*got 'far'"),
         ("baoding", {"near": 1.5, "soft": "yes"}, r"aids.turn_shaping.soft must be true or false, got 'yes'"),
         ("baoding", {"soft": True}, r"aids.turn_shaping.soft needs aids.turn_shaping.near .*got near=None"),
+        ("baoding", {"near_from": 3.0}, r"aids.turn_shaping.near_from needs aids.turn_shaping.near .*got near=None"),
+        ("baoding", {"near": 1.0, "near_from": 0.5}, r"aids.turn_shaping.near_from must be .* in \[1, 100\], got 0.5"),
+        ("baoding", {"near": 1.0, "near_turns": 0}, r"aids.turn_shaping.near_turns must be net turns .*got 0"),
     ],
 )
 def test_bad_turn_reward_is_refused(task, per_turn, pattern):

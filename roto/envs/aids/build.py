@@ -6,13 +6,14 @@ from roto.envs.aids.protocol import AidHost, TrainingAid
 from roto.envs.aids.replayed_starts import ReplayedStarts
 from roto.envs.aids.round_swaps import ArmedRoundSwaps, RoundSwaps
 from roto.envs.aids.tolerance import ToleranceAid
-from roto.envs.aids.turn_shaping import TurnShaping
+from roto.envs.aids.turn_shaping import NarrowingTurnShaping, TurnShaping
 
 
 def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
     """The aids ``host.config.aids`` switches on (none for an evaluation env): replayed starts,
     with the recorder of the envs' own events beside them when ``record_lead`` > 0, the tolerance
-    curriculum, round swaps (armed part way with ``after``), turn shaping."""
+    curriculum, round swaps (armed part way with ``after``), turn shaping (its ``near`` narrowing with
+    ``near_from``)."""
     section, aids = host.config.aids, []
     if section.replayed_starts is not None:
         replay = ReplayedStarts(host, section.replayed_starts)
@@ -25,5 +26,6 @@ def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
         armed = section.round_swaps.after is not None
         aids.append((ArmedRoundSwaps if armed else RoundSwaps)(host, section.round_swaps))
     if section.turn_shaping is not None:
-        aids.append(TurnShaping(host, section.turn_shaping))
+        narrowing = section.turn_shaping.near_from is not None
+        aids.append((NarrowingTurnShaping if narrowing else TurnShaping)(host, section.turn_shaping))
     return tuple(aids)

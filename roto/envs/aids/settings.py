@@ -143,12 +143,21 @@ class TurnShapingSettings:
         soft: with ``near``: beyond it the turning pays (near / offset)² of its reward (offset: the
             centre's distance from the midpoint in half separations) instead of nothing, so turning
             nearer the targets always pays more; shrinking is still charged in full anywhere.
+        near_from: with ``near``: None: ``near`` from the start; else ``near`` starts at
+            ``near_from`` and narrows to ``near`` as the training episodes' net turns (the running
+            mean of their size, ``roto.envs.aids.episode_mean.Narrowing``) reach ``near_turns``:
+            turning pays wherever the pair is while the policy learns to turn it, and near the
+            targets once it does.
+        near_turns: the training episodes' net turns at which ``near`` has narrowed from
+            ``near_from`` to ``near``.
     """
 
     per_turn: float = 20.0
     lead: float | None = None
     near: float | None = None
     soft: bool = False
+    near_from: float | None = None
+    near_turns: float = 3.0
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "turn_reward", "a ball pair")
@@ -163,6 +172,11 @@ class TurnShapingSettings:
             raise ValueError(
                 f"{path}.soft needs {path}.near (the half target separations it falls off beyond), got near=None"
             )
+        _number(f"{path}.near_turns", self.near_turns, 1e-9, 1e6, "net turns per episode")
+        if self.near_from is not None:
+            if self.near is None:
+                raise ValueError(f"{path}.near_from needs {path}.near (the value it narrows to), got near=None")
+            _number(f"{path}.near_from", self.near_from, self.near, 100.0, "half target separations from near")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -4,7 +4,7 @@ benchmark's as the training episodes succeed.
 For a task with a success radius (Baoding's latch radius, the task parameter ``success_radius``):
 the radius is ``end + (start - end) * max(0, 1 - mean / target)``, where ``mean`` is the running
 mean of the headline metric (Baoding: rotations) over the training episodes that ended so far
-(``roto.envs.aids.episode_mean``), ``start`` is ``ToleranceSettings.start`` and ``end`` the task's
+(``roto.envs.aids.episode_mean.Narrowing``), ``start`` is ``ToleranceSettings.start`` and ``end`` the task's
 own radius. So the radius is ``start`` while no episode succeeds, the task's own once the episodes
 reach ``ToleranceSettings.target`` on average, and widens again if they fall back. The update
 runs on the env's device in fixed shapes, never reading it. Evaluation envs never use it
@@ -13,45 +13,15 @@ runs on the env's device in fixed shapes, never reading it. Evaluation envs neve
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import torch
 
-from roto.envs.aids.episode_mean import fold_ended_episodes
+from roto.envs.aids.episode_mean import Narrowing
 from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
 from roto.envs.aids.settings import ToleranceSettings
 
 
-@dataclass
-class ToleranceCurriculum:
-    """Attributes: start and end radius (m), the target headline metric per episode, and the
-    running mean of that metric over ended training episodes (a () float64 tensor)."""
-
-    start: float
-    end: float
-    target: float
-    mean: torch.Tensor
-
-    def radius(self) -> torch.Tensor:
-        """() float64, the success radius for the running mean now."""
-        progress = torch.clamp(1.0 - self.mean / self.target, 0.0, 1.0)
-        return self.end + (self.start - self.end) * progress
-
-    def update(self, metric: torch.Tensor, done: torch.Tensor) -> torch.Tensor:
-        """Fold in the episodes that end now (``done`` (B,) bool, their headline ``metric`` (B,));
-        returns the new radius (``fold_ended_episodes``)."""
-        self.mean = fold_ended_episodes(self.mean, metric, done)
-        return self.radius()
-
-    def state_dict(self) -> dict[str, object]:
-        return {"mean": self.mean.clone()}
-
-    def load_state_dict(self, state: dict[str, object]) -> None:
-        self.mean = state["mean"].clone().to(self.mean.device)
-
-
 class ToleranceAid(TrainingAid):
-    """The aid: a ``ToleranceCurriculum`` fed the headline metric of every ended training episode,
+    """The aid: a ``Narrowing`` of the radius fed the headline metric of every ended training episode,
     setting the task's ``success_radius`` parameter (the ``tolerance`` aid)."""
 
     state_key = "tolerance_curriculum"
@@ -60,16 +30,16 @@ class ToleranceAid(TrainingAid):
     def __init__(self, host: AidHost, settings: ToleranceSettings) -> None:
         mean = torch.zeros((), dtype=torch.float64, device=host.device)
         end = host.task.parameters["success_radius"]
-        self.curriculum = ToleranceCurriculum(settings.start, end, settings.target, mean)
+        self.curriculum = Narrowing(settings.start, end, settings.target, mean)
         self.task, self.task_state = host.task, host.task_state
-        self.task.set_parameter(self.task_state, "success_radius", self.curriculum.radius())
+        self.task.set_parameter(self.task_state, "success_radius", self.curriculum.value())
 
     def observe(self, step: StepContext) -> None:
         """This step's ended episodes into the running mean, before their task state resets."""
         self.task.set_parameter(self.task_state, "success_radius", self.curriculum.update(step.metric, step.done))
 
     def metrics(self) -> dict[str, torch.Tensor]:
-        return {"train/success_radius": self.curriculum.radius()}
+        return {"train/success_radius": self.curriculum.value()}
 
     def state_dict(self) -> dict[str, object]:
         return self.curriculum.state_dict()

@@ -5,21 +5,21 @@ import pytest
 import torch
 
 import roto
-from roto.envs.aids.episode_mean import EPISODE_WEIGHT
+from roto.envs.aids.episode_mean import EPISODE_WEIGHT, Narrowing
 from roto.envs.aids.protocol import StepContext
-from roto.envs.aids.tolerance import ToleranceAid, ToleranceCurriculum
+from roto.envs.aids.tolerance import ToleranceAid
 from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
 from roto.tasks.baoding import SUCCESS_RADIUS, baoding_rule
 
 
 def curriculum(start=0.025, target=1.0):
-    return ToleranceCurriculum(start, SUCCESS_RADIUS, target, torch.zeros((), dtype=torch.float64))
+    return Narrowing(start, SUCCESS_RADIUS, target, torch.zeros((), dtype=torch.float64))
 
 
 def test_the_radius_narrows_with_the_running_mean_of_ended_episodes():
     c = curriculum()
-    assert float(c.radius()) == pytest.approx(0.025)
+    assert float(c.value()) == pytest.approx(0.025)
     done = torch.tensor([True, True, False, True])
     metric = torch.tensor([0.5, 0.5, 7.0, 0.5])  # the world still running does not count
     c.update(metric, done)
@@ -28,13 +28,13 @@ def test_the_radius_narrows_with_the_running_mean_of_ended_episodes():
     for _ in range(3):
         mean += EPISODE_WEIGHT * (0.5 - mean)
     assert float(c.mean) == pytest.approx(mean)
-    assert float(c.radius()) == pytest.approx(SUCCESS_RADIUS + 0.015 * (1.0 - mean))
+    assert float(c.value()) == pytest.approx(SUCCESS_RADIUS + 0.015 * (1.0 - mean))
     before = float(c.mean)
     c.update(metric, torch.zeros(4, dtype=torch.bool))  # nothing ended: nothing moves
     assert float(c.mean) == before
     for _ in range(2000):  # episodes at the target: the task's own radius
         c.update(torch.full((4,), 1.0), torch.ones(4, dtype=torch.bool))
-    assert float(c.radius()) == pytest.approx(SUCCESS_RADIUS, abs=1e-9)
+    assert float(c.value()) == pytest.approx(SUCCESS_RADIUS, abs=1e-9)
 
 
 def test_a_wider_radius_latches_a_ball_the_benchmarks_would_not():
