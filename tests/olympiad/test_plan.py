@@ -728,3 +728,14 @@ def test_the_turn_soft_continuation_is_its_probes_cell_at_20_m():
         twin = next(c for c in probe.cells if c.name == cell.name)
         mine, theirs = cell_spec(longer, cell), cell_spec(probe, twin)
         assert mine.differences(theirs) == {} and (mine.steps, theirs.steps) == (20_000_000, 10_000_000)
+
+
+def test_the_turn_focus_probe_is_the_allegros_baoding_cpu_cells_with_a_narrowing_near_at_20_m():
+    """experiments/baoding_turn_focus probes the Allegro's seeds 1 and 3, which baoding_cpu left off the targets."""
+    focus = {
+        "env.aids.turn_shaping.near": (1.0, None),
+        "env.aids.turn_shaping.soft": (True, False),
+        "env.aids.turn_shaping.near_from": (3.0, None),
+    }
+    plan = assert_baoding_cpu_cells_but("turn_focus", [("allegro", 1), ("allegro", 3)], focus)
+    assert plan.steps == 20_000_000
