@@ -25,7 +25,7 @@ def earlier(hand: str) -> str:
     return str(EARLIER_CONFIGS / f"baoding_cpu_{hand}.yaml")
 
 
-TURN_SHAPING = {"per_turn": 20, "lead": None, "near": None, "soft": False}
+TURN_SHAPING = {"per_turn": 20, "lead": None, "near": None, "soft": False, "near_from": None, "near_turns": 3.0}
 """baoding_cpu's turn shaping, every setting."""
 
 
