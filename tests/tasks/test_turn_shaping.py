@@ -188,6 +188,7 @@ def test_a_narrowing_near_starts_wide_narrows_as_the_episodes_turn_the_pair_and_
     assert float(shaping.metrics()["train/turn_near"]) == pytest.approx(float(env.task_state.turn_near))
     other = roto.make("baoding", robot="shadow", num_envs=4, seed=5, aids=NARROWING)
     other.load_state_dict(env.state_dict())
+    assert torch.equal(other.aid(NarrowingTurnShaping).near.mean, shaping.near.mean)
     assert torch.equal(other.task_state.turn_near, env.task_state.turn_near)
     env.task_state.net_turn.fill_(2.0)
     for _ in range(600):  # episodes that turn the pair near_turns: near itself
