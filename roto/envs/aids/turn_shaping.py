@@ -60,5 +60,4 @@ class NarrowingTurnShaping(TurnShaping):
         return self.near.state_dict()
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        self.near.load_state_dict(state)
-        self.task.set_parameter(self.task_state, "turn_near", self.near.value())
+        self.near.load_state_dict(state)  # turn_near itself comes back with the env's task state
