@@ -583,18 +583,25 @@ def test_the_every_hand_hold_study_trains_exactly_the_benchmarks_blind_baoding_c
         assert cell_spec(plan, cell).differences(cell_spec(benchmark, shared[cell.name])) == {}
 
 
-def test_the_allegros_20m_plan_continues_the_every_hand_studys_allegro_cells_with_only_a_larger_budget():
-    """experiments/baoding_hold_every_hand/allegro_20m.yaml: each cell is hold_every_hand's Allegro cell
-    of that seed but for its budget, so a run directory copied over from there continues (Trainer.open)."""
+def assert_continues_at_20_m(longer_name: str, study_name: str) -> list:
+    """Plan ``longer_name``'s cells are plan ``study_name``'s of the same names but for their budget
+    (20 M against 10 M), so a run directory copied over from there continues (Trainer.open); its cells."""
     from roto.olympiad.cell import cell_spec
 
-    longer, study = plan_named("allegro_20m"), plan_named("hold_every_hand")
+    longer, study = plan_named(longer_name), plan_named(study_name)
     shared = {c.name: c for c in study.cells}
-    assert longer.cells and {c.robot for c in longer.cells} == {"allegro"}
+    assert longer.cells
     for cell in longer.cells:
         mine, theirs = cell_spec(longer, cell), cell_spec(study, shared[cell.name])
         assert mine.differences(theirs) == {}
         assert (mine.steps, theirs.steps) == (20_000_000, 10_000_000)
+    return longer.cells
+
+
+def test_the_allegros_20m_plan_continues_the_every_hand_studys_allegro_cells_with_only_a_larger_budget():
+    """experiments/baoding_hold_every_hand/allegro_20m.yaml continues hold_every_hand's Allegro cells."""
+    cells = assert_continues_at_20_m("allegro_20m", "hold_every_hand")
+    assert {c.robot for c in cells} == {"allegro"}
 
 
 def test_the_round_bank_recipe_is_what_the_round_bank_study_trained_and_before_its_bank_what_the_others_did():
@@ -718,16 +725,8 @@ def test_the_forward_dynamics_study_is_baoding_cpu_with_only_roto_s_memory_loss_
 
 
 def test_the_turn_soft_continuation_is_its_probes_cell_at_20_m():
-    """experiments/baoding_turn_soft/turn_soft_20m.yaml continues the probe's cells: the same names
-    and run specs but the budget, so a run directory copied over from there continues."""
-    from roto.olympiad.cell import cell_spec
-
-    probe, longer = plan_named("turn_soft"), plan_named("turn_soft_20m")
-    assert longer.steps == 2 * probe.steps == 20_000_000
-    for cell in longer.cells:
-        twin = next(c for c in probe.cells if c.name == cell.name)
-        mine, theirs = cell_spec(longer, cell), cell_spec(probe, twin)
-        assert mine.differences(theirs) == {} and (mine.steps, theirs.steps) == (20_000_000, 10_000_000)
+    """experiments/baoding_turn_soft/turn_soft_20m.yaml continues the probe's cells."""
+    assert [c.seed for c in assert_continues_at_20_m("turn_soft_20m", "turn_soft")] == [1]
 
 
 def test_the_turn_focus_probe_is_the_allegros_baoding_cpu_cells_with_a_narrowing_near_at_20_m():
