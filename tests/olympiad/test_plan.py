@@ -724,6 +724,12 @@ def test_the_forward_dynamics_study_is_baoding_cpu_with_only_roto_s_memory_loss_
     assert_baoding_cpu_cells_but("forward_dynamics", [("shadow", s) for s in range(5)], added)
 
 
+def test_the_std_free_study_is_baoding_cpu_with_its_std_projected_and_no_entropy_bonus():
+    """experiments/baoding_std_free pairs each seed with baoding_hold_start's run of baoding_cpu."""
+    free = {"agent.network.project_log_std": (True, False), "agent.ppo.entropy_coef": (0.0, 0.05)}
+    assert_baoding_cpu_cells_but("std_free", [("shadow", s) for s in range(5)], free)
+
+
 def test_the_turn_soft_continuation_is_its_probes_cell_at_20_m():
     """experiments/baoding_turn_soft/turn_soft_20m.yaml continues the probe's cells."""
     assert [c.seed for c in assert_continues_at_20_m("turn_soft_20m", "turn_soft")] == [1]
