@@ -730,6 +730,12 @@ def test_the_std_free_study_is_baoding_cpu_with_its_std_projected_and_no_entropy
     assert_baoding_cpu_cells_but("std_free", [("shadow", s) for s in range(5)], free)
 
 
+def test_the_low_noise_study_is_baoding_cpu_with_its_std_bounded_at_0_15():
+    """experiments/baoding_low_noise pairs each seed with baoding_hold_start's run of baoding_cpu."""
+    lower = {"agent.network.init_log_std": (-1.897, -1.386), "agent.network.max_log_std": (-1.897, -1.386)}
+    assert_baoding_cpu_cells_but("low_noise", [("shadow", s) for s in range(5)], lower)
+
+
 def test_the_turn_soft_continuation_is_its_probes_cell_at_20_m():
     """experiments/baoding_turn_soft/turn_soft_20m.yaml continues the probe's cells."""
     assert [c.seed for c in assert_continues_at_20_m("turn_soft_20m", "turn_soft")] == [1]
