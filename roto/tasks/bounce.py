@@ -30,6 +30,8 @@ SPAWN_NOISE = 0.01
 MIN_FLIGHT_STEPS = 5
 """A new contact counts only after this many consecutive control steps without contact."""
 BOUNCE_REWARD = 10.0
+PARAMETER_FIELDS = MappingProxyType({"drop_penalty": "drop_penalty"})
+"""{task parameter: the ``BounceState`` field that holds it}."""
 HORIZONTAL_LIMIT = 0.2
 """A ball further than this from the palm centre horizontally ends the episode (m)."""
 
@@ -42,6 +44,8 @@ class BounceState:
     waiting: torch.Tensor  # bool: contact was lost since the last counted bounce
     steps_without_contact: torch.Tensor  # int64: consecutive steps without contact before now
     bounces: torch.Tensor  # int64: bounces this episode
+    # the drop-penalty training aid (roto.envs.aids.drop_penalty); 0 (the benchmark) charges nothing
+    drop_penalty: torch.Tensor  # () float64: reward charged when an episode ends with the ball lost
 
 
 def bounce_counter(
@@ -88,12 +92,12 @@ class Bounce:
     selection_metric = None
     """``best.pt`` goes by the return, as roto's does."""
     path_metric_names = ()
-    parameters = MappingProxyType({})
-    """Bounce has no parameter a training aid may change."""
+    parameters = MappingProxyType({"drop_penalty": 0.0})
+    """The parameter a training aid may change, at the benchmark's value: nothing charged for a lost ball."""
 
     def set_parameter(self, state: BounceState, name: str, value: float | torch.Tensor) -> None:
-        """Bounce has no parameters (``Task.set_parameter``): refuses every name."""
-        set_state_parameter(state, {}, name, value)
+        """Set ``drop_penalty`` of every world (``Task.set_parameter``)."""
+        set_state_parameter(state, PARAMETER_FIELDS, name, value)
 
     def balls(self, robot: RobotSpec) -> tuple[BallSpec, ...]:
         """One 70 mm, 30 g ball for every hand."""
@@ -103,7 +107,8 @@ class Bounce:
         """All counters at zero."""
         zeros_b = torch.zeros(num_envs, dtype=torch.bool, device=device)
         zeros_i = torch.zeros(num_envs, dtype=torch.int64, device=device)
-        return BounceState(zeros_b, zeros_b.clone(), zeros_i, zeros_i.clone())
+        no_penalty = torch.zeros((), dtype=torch.float64, device=device)
+        return BounceState(zeros_b, zeros_b.clone(), zeros_i, zeros_i.clone(), no_penalty)
 
     def reset(self, state: BounceState, mask: torch.Tensor) -> None:
         """Clear the counters of the worlds in ``mask`` (B,) bool."""
@@ -117,7 +122,8 @@ class Bounce:
         return pos
 
     def step(self, state: BounceState, inputs: TaskInputs) -> StepResult:
-        """Count bounces (hand-ball contact only), reward 10 per bounce, end on a dropped ball."""
+        """Count bounces (hand-ball contact only), reward 10 per bounce, end on a dropped ball (a
+        "drop" term charges ``drop_penalty`` then: 0 for the benchmark)."""
         contact = inputs.ball_contact[:, 0]
         bounce, state.waiting, state.steps_without_contact = bounce_counter(
             contact, state.prev_contact, state.waiting, state.steps_without_contact
@@ -126,7 +132,9 @@ class Bounce:
         state.bounces += bounce
         pos = inputs.ball_pos[:, 0]
         terminated = (pos[:, 2] < -PALM_DROP_LIMIT) | (squared_norm(pos[:, :2]) > HORIZONTAL_LIMIT**2)
-        return StepResult(reward_terms={"bounce": BOUNCE_REWARD * as_dtype_of(bounce, pos)}, terminated=terminated)
+        lost = as_dtype_of(terminated, pos) * as_dtype_of(state.drop_penalty, pos)
+        terms = {"bounce": BOUNCE_REWARD * as_dtype_of(bounce, pos), "drop": -lost}
+        return StepResult(reward_terms=terms, terminated=terminated)
 
     def metrics(self, state: BounceState) -> dict[str, torch.Tensor]:
         """Bounces so far this episode."""

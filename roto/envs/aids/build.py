@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from roto.envs.aids.drop_penalty import DropPenalty
 from roto.envs.aids.protocol import AidHost, TrainingAid
 from roto.envs.aids.replayed_starts import ReplayedStarts
 from roto.envs.aids.round_swaps import ArmedRoundSwaps, RoundSwaps
@@ -13,7 +14,7 @@ def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
     """The aids ``host.config.aids`` switches on (none for an evaluation env): replayed starts,
     with the recorder of the envs' own events beside them when ``record_lead`` > 0, the tolerance
     curriculum, round swaps (armed part way with ``after``), turn shaping (its ``near`` narrowing with
-    ``near_from``)."""
+    ``near_from``), the drop penalty."""
     section, aids = host.config.aids, []
     if section.replayed_starts is not None:
         replay = ReplayedStarts(host, section.replayed_starts)
@@ -28,4 +29,6 @@ def build_aids(host: AidHost) -> tuple[TrainingAid, ...]:
     if section.turn_shaping is not None:
         narrowing = section.turn_shaping.near_from is not None
         aids.append((NarrowingTurnShaping if narrowing else TurnShaping)(host, section.turn_shaping))
+    if section.drop_penalty is not None:
+        aids.append(DropPenalty(host, section.drop_penalty))
     return tuple(aids)

@@ -36,9 +36,9 @@ def _count(path: str, value: object, low: int) -> None:
         raise ValueError(f"{path} must be an integer >= {low}, got {value!r}")
 
 
-def _needs_parameter(path: str, task: Any, parameter: str, what: str) -> None:
+def _needs_parameter(path: str, task: Any, parameter: str, what: str, tasks: str = "baoding") -> None:
     if parameter not in task.parameters:
-        raise ValueError(f"{path} applies to a task with {what} (baoding); task {task.name!r} has none")
+        raise ValueError(f"{path} applies to a task with {what} ({tasks}); task {task.name!r} has none")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -180,6 +180,23 @@ class TurnShapingSettings:
 
 
 @dataclass(frozen=True, kw_only=True)
+class DropPenaltySettings:
+    """A training episode that ends with the ball lost is charged (``roto.envs.aids.drop_penalty``).
+
+    Attributes:
+        per_drop: the reward charged on the control step an episode ends by losing the ball (the
+            task's termination; an episode that runs its 10 s is not charged). 10 is one bounce's
+            pay, so an episode that bounces once and loses the ball earns nothing.
+    """
+
+    per_drop: float = 10.0
+
+    def check(self, path: str, task: Any) -> None:
+        _needs_parameter(path, task, "drop_penalty", "a ball to lose", "bounce")
+        _number(f"{path}.per_drop", self.per_drop, 0.0, 1000.0, "a reward charged per lost ball")
+
+
+@dataclass(frozen=True, kw_only=True)
 class AidsConfig:
     """The aids section: one entry per aid, None where it is off (the benchmark: all None)."""
 
@@ -187,6 +204,7 @@ class AidsConfig:
     tolerance: ToleranceSettings | None = None
     round_swaps: RoundSwapsSettings | None = None
     turn_shaping: TurnShapingSettings | None = None
+    drop_penalty: DropPenaltySettings | None = None
 
     def active(self) -> dict[str, Any]:
         """{aid: its settings} of the aids that are on, in the section's order."""

@@ -28,7 +28,7 @@ def test_the_section_reads_plain_data_and_writes_back_only_the_aids_that_are_on(
     [
         ([1], r"aids must be a mapping of aid names to settings, got \[1\]; aids: \['replayed_starts'"),
         ({"tolerance": 0.02}, r"aids.tolerance must be a mapping of its settings, got 0.02"),
-        ({"turn": {}}, r"unknown training aid aids.turn; valid aids: \[.*'turn_shaping'\]"),
+        ({"turn": {}}, r"unknown training aid aids.turn; valid aids: \[.*'turn_shaping', 'drop_penalty'\]"),
         ({"round_swaps": {"turns": 1}}, r"unknown setting\(s\) \['turns'\] of aids.round_swaps; valid settings"),
     ],
 )
