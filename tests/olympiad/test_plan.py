@@ -750,3 +750,16 @@ def test_the_turn_focus_probe_is_the_allegros_baoding_cpu_cells_with_a_narrowing
     }
     plan = assert_baoding_cpu_cells_but("turn_focus", [("allegro", 1), ("allegro", 3)], focus)
     assert plan.steps == 20_000_000
+
+
+def test_the_drop_penalty_study_is_the_benchmarks_bounce_cells_with_only_the_aid():
+    """experiments/bounce_drop_penalty pairs each cell with the benchmark's run of the same hand, mode and seed."""
+    from roto.olympiad.cell import cell_spec
+
+    plan, benchmark = plan_named("drop_penalty"), plan_named("benchmark")
+    hands, modes = ("shadow_lite", "allegro"), ("state", "proprio")
+    pairs = {(robot, obs, seed) for robot in hands for obs in modes for seed in (0, 1)}
+    assert {(c.robot, c.obs, c.seed) for c in plan.cells} == pairs and plan.steps == benchmark.steps
+    for cell in plan.cells:
+        same = cell_spec(benchmark, Cell("bounce", cell.robot, cell.obs, "ppo", cell.seed))
+        assert cell_spec(plan, cell).differences(same) == {"env.aids.drop_penalty": ({"per_drop": 10.0}, None)}
