@@ -256,8 +256,8 @@ def _against(values: dict[int, float], base: dict[int, float]) -> list[str]:
 
 
 def variants_table(summaries: list[dict], baseline: str, plan: Plan | None = None) -> str:
-    """Markdown: per (task, hand, obs mode) that has the ``baseline`` variant, that variant and then
-    every other, each with its config, seeds, lead measure (mean ± std, per seed), seeds by path
+    """Markdown: per (task, hand, obs mode) that has the ``baseline`` variant and another, the
+    baseline and then every other, each with its config, seeds, lead measure (mean ± std, per seed), seeds by path
     (Baoding), and against the baseline on the seeds both trained: the mean paired difference
     with its 95 % bootstrap interval (three shared seeds or more) and how many seeds did better
     and worse. A change is judged on the same seeds, seed by seed, not only by its mean."""
@@ -273,6 +273,8 @@ def variants_table(summaries: list[dict], baseline: str, plan: Plan | None = Non
             kinds.setdefault((s["robot"], s["obs"], s["variant"]), []).append(seed_path_kind(task, s))
         for robot, obs in dict.fromkeys((r, o) for r, o, v in sorted(values, key=_row_order) if v == baseline):
             rows = sorted((row for row in values if row[:2] == (robot, obs)), key=lambda r: (r[2] != baseline, r[2]))
+            if len(rows) == 1:  # the baseline alone: nothing to set beside it
+                continue
             for row in rows:
                 seeds = values[row]
                 scores = np.array([seeds[s] for s in sorted(seeds)])

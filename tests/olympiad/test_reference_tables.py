@@ -247,6 +247,17 @@ def test_the_variants_table_sets_each_variant_beside_the_baseline_seed_by_seed()
     assert other[9:] == ["none", "", ""]
 
 
+def test_a_hand_and_mode_with_the_baseline_alone_gets_no_rows():
+    """A baseline folder holds more pairs than a study trained (the benchmark's): only pairs with a
+    variant beside the baseline are listed."""
+    from roto.olympiad.reference_tables import variants_table
+
+    alone = {**baoding("base", 0, 4.0, 4.0), "robot": "orca"}
+    lines = variants_table([*VARIANT_SUMMARIES, alone], "base").splitlines()
+    assert [line.split(" | ")[1] for line in lines[2:]] == ["shadow"] * 3
+    assert variants_table([alone], "base").splitlines()[2:] == []
+
+
 def test_a_variants_block_needs_its_baseline_and_known_options(tmp_path):
     write_folder(tmp_path / "s", VARIANT_SUMMARIES)
     text = "<!-- roto results: variants s baseline=base -->\nold\n<!-- /roto results -->\n"
