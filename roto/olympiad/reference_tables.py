@@ -257,10 +257,11 @@ def _against(values: dict[int, float], base: dict[int, float]) -> list[str]:
 
 def variants_table(summaries: list[dict], baseline: str, plan: Plan | None = None) -> str:
     """Markdown: per (task, hand, obs mode) that has the ``baseline`` variant and another, the
-    baseline and then every other, each with its config, seeds, lead measure (mean ± std, per seed), seeds by path
-    (Baoding), and against the baseline on the seeds both trained: the mean paired difference
-    with its 95 % bootstrap interval (three shared seeds or more) and how many seeds did better
-    and worse. A change is judged on the same seeds, seed by seed, not only by its mean."""
+    baseline and then every other, each with its config, seeds, lead measure (mean ± std, per
+    seed), seeds by path (Baoding), and against the baseline on the seeds both trained: the mean
+    paired difference with its 95 % bootstrap interval (three shared seeds or more) and how many
+    seeds did better and worse. A change is judged on the same seeds, seed by seed, not only by
+    its mean."""
     head = ["task", "hand", "obs", "variant", "agent config", "seeds", "mean ± std", "per seed", "seeds by path"]
     head += [f"seeds shared with {baseline}", "paired difference [95 % CI]", "seeds better / worse"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]

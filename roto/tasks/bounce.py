@@ -30,10 +30,10 @@ SPAWN_NOISE = 0.01
 MIN_FLIGHT_STEPS = 5
 """A new contact counts only after this many consecutive control steps without contact."""
 BOUNCE_REWARD = 10.0
-PARAMETER_FIELDS = MappingProxyType({"drop_penalty": "drop_penalty"})
-"""{task parameter: the ``BounceState`` field that holds it}."""
 HORIZONTAL_LIMIT = 0.2
 """A ball further than this from the palm centre horizontally ends the episode (m)."""
+PARAMETER_FIELDS = MappingProxyType({"drop_penalty": "drop_penalty"})
+"""{task parameter: the ``BounceState`` field that holds it}."""
 
 
 @dataclass
