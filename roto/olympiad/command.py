@@ -107,8 +107,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     if args.dry_run:
         if args.workers < 1:
             raise ValueError(f"--workers must be >= 1, got {args.workers}")
-        whole = len(plan.cells) if args.only else None
-        print(dry_run_report(chosen, args.root, results, args.storage, args.workers, whole))
+        print(dry_run_report(chosen, args.root, results, args.storage, args.workers, plan if args.only else None))
         return 0
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
@@ -166,11 +165,11 @@ def status_metrics(task: Task, records: list[dict]) -> tuple[str, tuple[str, ...
 
 
 def dry_run_report(
-    plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1, of_cells: int | None = None
+    plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1, whole: Plan | None = None
 ) -> str:
     """The cells and their status, and the time left for the env steps left (a started cell counts
-    the env steps of its run's last evaluation; ``time_left_estimate``). ``of_cells``: the plan's
-    whole count, when ``plan`` holds only the cells ``--only`` chose."""
+    the env steps of its run's last evaluation; ``time_left_estimate``). ``whole``: the plan
+    ``--only`` chose ``plan``'s cells from, whose finished cells give the throughput."""
     from roto.olympiad.time_left import recent_rate
     from roto.olympiad.worker import cell_status
     from roto.rl.evaluation import read_evaluations
@@ -181,7 +180,7 @@ def dry_run_report(
     budgets = {cell.name: plan.steps_for(cell) for cell in plan.cells}
     uniform = len(set(budgets.values())) == 1
     each = f"{plan.steps} env steps each" if uniform else "env steps per cell as listed"
-    chosen = f" of its {of_cells} (--only)" if of_cells is not None else ""
+    chosen = f" of its {len(whole.cells)} (--only)" if whole is not None else ""
     lines = [f"plan {plan.name}: {len(plan.cells)} cells{chosen}, {each}", ""]
     done_steps, started_rates = {}, []
     for name, state in status.items():
@@ -196,17 +195,17 @@ def dry_run_report(
     left = sum(state != "done" for state in status.values())
     steps_left = {name: budgets[name] - done_steps[name] for name, state in status.items() if state != "done"}
     lines += ["", f"{len(status) - left} done, {left} left; time left: "]
-    lines[-1] += time_left_estimate(plan, results, steps_left, started_rates, workers)
+    lines[-1] += time_left_estimate(whole or plan, results, steps_left, started_rates, workers)
     return "\n".join(lines)
 
 
 def time_left_estimate(
     plan: Plan, results: pathlib.Path, steps_left: dict[str, int], started_rates: list[float], workers: int
 ) -> str:
-    """How long ``steps_left`` (env steps left per unfinished cell) takes: each cell at its task's
-    finished cells' throughput (the plan's summaries in ``results``), a task with none at all the
-    finished cells' throughput, or with none finished at the started cells' latest throughput; for
-    one worker, and with several, until the busiest one is done."""
+    """How long ``steps_left`` (env steps left per unfinished cell of ``plan``) takes: each cell
+    at its task's finished cells' throughput (the plan's summaries in ``results``), a task with
+    none at all the finished cells' throughput, or with none finished at the started cells' latest
+    throughput; for one worker, and with several, until the busiest one is done."""
     from roto.olympiad.plan import Cell
     from roto.olympiad.results import read_summaries
     from roto.olympiad.time_left import busiest_worker_load, cell_seconds, rate_sources, task_throughputs, throughput

@@ -197,11 +197,18 @@ def test_cli_only_lists_the_chosen_cells_and_refuses_a_pattern_that_matches_none
     assert out.startswith("plan benchmark: 6 cells of its 80 (--only), env steps per cell as listed")
     assert out.count("-orca-state-ppo-seed") == 6
     assert "bounce-shadow" not in out and "6 left" in out
+    committed = ROOT / "benchmarks" / "results" / "benchmark" / "cells" / "bounce-shadow-blind-ppo-seed0.json"
+    results.mkdir()
+    done = {**json.loads(committed.read_text()), "env_steps": 5_000_000, "train_wall_s": 1000.0}  # 5000 env steps/s
+    (results / committed.name).write_text(json.dumps(done))
+    assert main([*argv, "--only", "bounce-orca-state-*"]) == 0  # a cell --only left out sets the pace
+    out = capsys.readouterr().out  # 3 cells of 5 M at 5000 env steps/s = 3000 s
+    assert "0 done, 3 left; time left: 0.8 h for one worker at bounce 5000 env steps/s" in out
     assert (
         main(["olympiad", "benchmark", "--root", str(root), "--results", str(results), "--only", "baoding-ghost*"]) == 2
     )
     assert "--only 'baoding-ghost*' matches none of the 80 cells of plan 'benchmark'" in capsys.readouterr().err
-    assert not root.exists() and not results.exists()
+    assert not root.exists() and sorted(p.name for p in results.iterdir()) == [committed.name]
 
 
 def test_variant_plans_carry_env_overrides_into_their_cells_and_name_their_agents():
