@@ -1,5 +1,6 @@
 import dataclasses
 import json
+import math
 import pathlib
 
 import pytest
@@ -770,3 +771,14 @@ def test_the_drop_penalty_study_is_the_benchmarks_bounce_cells_with_only_the_aid
     for cell in plan.cells:
         same = cell_spec(benchmark, Cell("bounce", cell.robot, cell.obs, "ppo", cell.seed))
         assert cell_spec(plan, cell).differences(same) == {"env.aids.drop_penalty": ({"per_drop": 10.0}, None)}
+
+
+def test_the_hold_noise_probe_bounds_the_allegros_std_at_the_noise_its_hold_tolerates():
+    """experiments/baoding_hold_noise probes the Allegro's seeds 1 and 3 with the std its hold pose tolerates."""
+    from roto.reference.hold import tolerated_noise
+
+    rows = json.loads((ROOT / "benchmarks/results/baoding_reference/hold_noise.json").read_text())
+    assert tolerated_noise(rows, "allegro") == 0.15
+    lower = {"agent.network.init_log_std": (-1.897, -1.386), "agent.network.max_log_std": (-1.897, -1.386)}
+    plan = assert_baoding_cpu_cells_but("hold_noise", [("allegro", 1), ("allegro", 3)], lower)
+    assert plan.steps == 10_000_000 and abs(math.exp(-1.897) - 0.15) < 1e-3
