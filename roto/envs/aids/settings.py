@@ -5,7 +5,7 @@ settings (frozen, strict keys, checked on construction). Evaluation envs carry n
 In YAML (an env config, an agent config's ``training_aids`` section, ``roto.make(aids=...)``)::
 
     aids:
-      replayed_starts: {bank: starts/shadow_preswap.npz, share: 0.5, record_lead: 10}
+      replayed_starts: {bank: "{robot}_round_preswap", share: 0.5, record_lead: 10}
       tolerance: {start: 0.025, target: 2}
       round_swaps: {min_turn: 0.25}
       turn_shaping: {per_turn: 20}
