@@ -285,7 +285,14 @@ def _add_render_parser(sub: argparse._SubParsersAction) -> None:
         "--out", default="scene.png", help="PNG or JPEG path (default: scene.png; missing folders are created)"
     )
     add_touch_arg(p_render)
-    p_render.add_argument("--settle_steps", "--settle-steps", dest="settle_steps", type=int, default=60)
+    p_render.add_argument(
+        "--settle_steps",
+        "--settle-steps",
+        dest="settle_steps",
+        type=int,
+        default=60,
+        help="control steps holding the default pose before the picture (default: 60)",
+    )
     p_render.add_argument("--seed", type=int, default=0)
     p_render.set_defaults(func=_cmd_render)
 

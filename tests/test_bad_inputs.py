@@ -108,6 +108,11 @@ CASES = {
         "is not a directory (it is a file)",
     ),
     "image of an unknown format": (lambda d: ["render", "--out", str(d / "scene.xyz")], 2, "['.png', '.jpg'"),
+    "negative settle steps": (
+        lambda d: ["render", "--settle_steps", "-5", "--out", str(d / "new" / "scene.png")],
+        2,
+        "--settle_steps must be >= 0 control steps, got -5",
+    ),
     "evaluation at a directory": (lambda d: ["eval", "--checkpoint", "x.pt", "--out", str(d)], 2, "is a directory"),
     "evaluation under a file": (
         lambda d: ["eval", "--checkpoint", "x.pt", "--out", write(d / "file", "") + "/e.json"],
