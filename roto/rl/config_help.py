@@ -64,13 +64,23 @@ def nested_dataclass(annotation: Any) -> type | None:
     return annotation if dataclasses.is_dataclass(annotation) else None
 
 
+class Required:
+    """The default shown for a setting a section needs a value for (``required``)."""
+
+    def __repr__(self) -> str:
+        return "required"
+
+
+REQUIRED = Required()
+
+
 def default_of(field: dataclasses.Field) -> Any:
-    """A field's default value (None when it has none)."""
+    """A field's default value (``REQUIRED`` when it has none)."""
     if field.default is not dataclasses.MISSING:
         return field.default
     if field.default_factory is not dataclasses.MISSING:
         return field.default_factory()
-    return None
+    return REQUIRED
 
 
 def config_keys(cls: type, prefix: str = "", skip: tuple[str, ...] = ()) -> list[tuple[str, Any, str]]:
@@ -81,7 +91,7 @@ def config_keys(cls: type, prefix: str = "", skip: tuple[str, ...] = ()) -> list
         if field.name in skip:
             continue
         key, nested = f"{prefix}{field.name}", nested_dataclass(hints[field.name])
-        if nested is not None and default_of(field) is None:  # an optional section, off by default
+        if nested is not None and field.default is None:  # an optional section, off by default
             summary = " ".join(inspect.cleandoc(nested.__doc__ or "").split("\n\n")[0].split())
             rows.append((key, None, docs.get(field.name, "") or f"on when set: {summary}"))
             rows += config_keys(nested, f"{key}.")

@@ -29,6 +29,9 @@ def test_help_config_prints_keys_defaults_and_meanings(capsys):
     assert out == help_config() + "\n"
     rollouts = next(line for line in out.splitlines() if line.strip().startswith("ppo.rollouts "))
     assert " 16 " in rollouts and "Steps each env collects per update" in rollouts
+    shown = {line.split()[0]: line.split()[1] for line in out.splitlines() if line.startswith("  env.aids.")}
+    assert shown["env.aids.replayed_starts.bank"] == shown["env.aids.tolerance.start"] == "required"
+    assert shown["env.aids.replayed_starts"] == "None" and shown["env.aids.replayed_starts.share"] == "0.25"
 
 
 def test_attribute_sections_join_continuation_lines():
