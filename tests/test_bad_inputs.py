@@ -111,7 +111,7 @@ CASES = {
     "negative settle steps": (
         lambda d: ["render", "--settle_steps", "-5", "--out", str(d / "new" / "scene.png")],
         2,
-        "--settle_steps must be >= 0 control steps, got -5",
+        "settle_steps must be >= 0 control steps, got -5",
     ),
     "evaluation at a directory": (lambda d: ["eval", "--checkpoint", "x.pt", "--out", str(d)], 2, "is a directory"),
     "evaluation under a file": (

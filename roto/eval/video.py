@@ -190,7 +190,7 @@ def render_scene(
     from roto.envs.config import EnvConfig
 
     if settle_steps < 0:
-        raise ValueError(f"--settle_steps must be >= 0 control steps, got {settle_steps}")
+        raise ValueError(f"settle_steps must be >= 0 control steps, got {settle_steps}")
     path = check_output_path(path, "image path", example="scene.png")
     if path.suffix.lower() not in IMAGE_SUFFIXES:
         raise ValueError(f"image path {str(path)!r}: give a file ending in one of {list(IMAGE_SUFFIXES)}")
