@@ -354,7 +354,7 @@ def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_
     assert three.differences(one) == {
         "env.aids.replayed_starts.share": (0.5, 0.25),
         "env.aids.replayed_starts.record_lead": (10, 0),
-        "env.aids.tolerance": ({"start": 0.025, "target": 2}, None),
+        "env.aids.tolerance": ({"start": 0.025, "target": 2, "by": "headline"}, None),
     }
 
 
@@ -372,7 +372,7 @@ def test_each_ablation_changes_exactly_its_part_of_the_baoding_recipe():
         "recipe": {},
         "no_replay": {"env.aids.replayed_starts": (None, replayed)},
         "no_own_swaps": {"env.aids.replayed_starts.record_lead": (0, 10)},
-        "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2})},
+        "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2, "by": "headline"})},
         "plain_critic": {"agent.network.critic": (None, ["tactile", "proprio", "privileged", "task"])},
         "roto_epochs": {"agent.ppo.epochs": (8, 4)},
         "std_bound": {"agent.network.max_log_std": (0.0, 2.0)},
@@ -651,7 +651,7 @@ def test_each_part_of_baoding_cpu_is_switched_off_by_exactly_one_ablation():
         "no_turn_shaping": {"env.aids.turn_shaping": (None, TURN_SHAPING)},
         "no_replayed_starts": {"env.aids.replayed_starts": (None, replayed)},
         "no_recording": {"env.aids.replayed_starts.record_lead": (0, 10)},
-        "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2})},
+        "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2, "by": "headline"})},
         "std_1": {"agent.network.init_log_std": (0.0, -1.386), "agent.network.max_log_std": (0.0, -1.386)},
         "plain_critic": {"agent.network.critic": (None, ["tactile", "proprio", "privileged", "task"])},
     }
@@ -757,6 +757,18 @@ def test_the_turn_focus_probe_is_the_allegros_baoding_cpu_cells_with_a_narrowing
         "env.aids.turn_shaping.near_from": (3.0, None),
     }
     plan = assert_baoding_cpu_cells_but("turn_focus", [("allegro", 1), ("allegro", 3)], focus)
+    assert plan.steps == 20_000_000
+
+
+def test_the_turn_latch_probe_is_turn_focus_with_the_latch_narrowing_by_net_turns():
+    """experiments/baoding_turn_latch: turn_focus's cells with the tolerance measured by net turns."""
+    focus = {
+        "env.aids.turn_shaping.near": (1.0, None),
+        "env.aids.turn_shaping.soft": (True, False),
+        "env.aids.turn_shaping.near_from": (3.0, None),
+        "env.aids.tolerance.by": ("net_turns", "headline"),
+    }
+    plan = assert_baoding_cpu_cells_but("turn_latch", [("allegro", 1), ("allegro", 3)], focus)
     assert plan.steps == 20_000_000
 
 

@@ -73,6 +73,10 @@ class ReplayedStartsSettings:
             )
 
 
+TOLERANCE_MEASURES = ("headline", "net_turns")
+"""What a tolerance curriculum's episodes may be measured by (``ToleranceSettings.by``)."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class ToleranceSettings:
     """The task's success radius starts wide and narrows to its own as training episodes succeed
@@ -80,18 +84,27 @@ class ToleranceSettings:
 
     Attributes:
         start: the radius (m) while no training episode succeeds (at least the task's own).
-        target: the headline metric per training episode (Baoding: rotations) at which the radius
-            is the task's own.
+        target: the training episodes' mean of ``by`` at which the radius is the task's own.
+        by: what the episodes are measured by: ``headline``, the task's headline metric
+            (Baoding: rotations, counted at the radius of the moment, so a policy that latches only
+            at a wide radius can hold it wide); ``net_turns``, the size of the ball pair's net
+            turning, which no radius changes (Baoding), so the radius narrows as the policy learns
+            to turn the pair wherever it turns it.
     """
 
     start: float
     target: float = 1.0
+    by: str = "headline"
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "success_radius", "a success radius")
         own = task.parameters["success_radius"]
         _number(f"{path}.start", self.start, own, 1.0, f"a radius (m) no smaller than the task's own {own}")
-        _number(f"{path}.target", self.target, 1e-9, 1e6, "a headline metric per episode")
+        _number(f"{path}.target", self.target, 1e-9, 1e6, f"a mean of {self.by} per episode")
+        if self.by not in TOLERANCE_MEASURES:
+            raise ValueError(f"{path}.by must be one of {list(TOLERANCE_MEASURES)}, got {self.by!r}")
+        if self.by == "net_turns":
+            _needs_parameter(f"{path}.by", task, "turn_reward", "a ball pair")
 
 
 @dataclass(frozen=True, kw_only=True)

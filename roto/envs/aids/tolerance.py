@@ -3,7 +3,8 @@ benchmark's as the training episodes succeed.
 
 For a task with a success radius (Baoding's latch radius, the task parameter ``success_radius``):
 the radius is ``end + (start - end) * max(0, 1 - mean / target)``, where ``mean`` is the running
-mean of the headline metric (Baoding: rotations) over the training episodes that ended so far
+mean, over the training episodes that ended so far, of the headline metric (Baoding: rotations)
+or, with ``ToleranceSettings.by: net_turns``, of the size of the ball pair's net turning
 (``roto.envs.aids.episode_mean.Narrowing``), ``start`` is ``ToleranceSettings.start`` and ``end`` the task's
 own radius. So the radius is ``start`` while no episode succeeds, the task's own once the episodes
 reach ``ToleranceSettings.target`` on average, and widens again if they fall back. The update
@@ -21,8 +22,9 @@ from roto.envs.aids.settings import ToleranceSettings
 
 
 class ToleranceAid(TrainingAid):
-    """The aid: a ``Narrowing`` of the radius fed the headline metric of every ended training episode,
-    setting the task's ``success_radius`` parameter (the ``tolerance`` aid)."""
+    """The aid: a ``Narrowing`` of the radius fed the headline metric (or the pair's net turns) of
+    every ended training episode, setting the task's ``success_radius`` parameter (the
+    ``tolerance`` aid)."""
 
     state_key = "tolerance_curriculum"
     watches_steps = True
@@ -32,11 +34,13 @@ class ToleranceAid(TrainingAid):
         end = host.task.parameters["success_radius"]
         self.curriculum = Narrowing(settings.start, end, settings.target, mean)
         self.task, self.task_state = host.task, host.task_state
+        self.by_net_turns = settings.by == "net_turns"
         self.task.set_parameter(self.task_state, "success_radius", self.curriculum.value())
 
     def observe(self, step: StepContext) -> None:
         """This step's ended episodes into the running mean, before their task state resets."""
-        self.task.set_parameter(self.task_state, "success_radius", self.curriculum.update(step.metric, step.done))
+        measure = step.task_state.net_turn.abs() if self.by_net_turns else step.metric
+        self.task.set_parameter(self.task_state, "success_radius", self.curriculum.update(measure, step.done))
 
     def metrics(self) -> dict[str, torch.Tensor]:
         return {"train/success_radius": self.curriculum.value()}

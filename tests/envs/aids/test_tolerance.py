@@ -1,12 +1,15 @@
 """The tolerance curriculum: Baoding's latch radius starts wide, narrows as training episodes
 rotate, is saved with the env, is refused where a task has no radius, and never reaches evaluation."""
 
+from types import SimpleNamespace
+
 import pytest
 import torch
 
 import roto
 from roto.envs.aids.episode_mean import EPISODE_WEIGHT, Narrowing
 from roto.envs.aids.protocol import StepContext
+from roto.envs.aids.settings import ToleranceSettings
 from roto.envs.aids.tolerance import ToleranceAid
 from roto.envs.config import EnvConfig
 from roto.rl.run_spec import RunSpec
@@ -68,6 +71,26 @@ def test_a_baoding_env_starts_wide_narrows_as_its_episodes_rotate_and_resumes_ex
     assert plain.aid(ToleranceAid) is None and float(plain.task_state.radius) == SUCCESS_RADIUS
 
 
+def test_by_net_turns_the_radius_narrows_as_the_pair_turns_with_no_latch_counted():
+    aids = {"tolerance": {"start": 0.03, "target": 2.0, "by": "net_turns"}}
+    env = roto.make("baoding", robot="allegro", num_envs=4, seed=0, aids=aids)
+    env.reset()
+    env.task_state.net_turn.copy_(torch.tensor([3.0, -3.0, 1.0, 9.0], dtype=torch.float64))  # either way round
+    no_rotations = torch.zeros(4, dtype=torch.float64)
+    ended = torch.tensor([True, True, True, False])
+    env.aid(ToleranceAid).observe(StepContext(None, None, None, env.task_state, no_rotations, None, ended))
+    sizes = torch.tensor([3.0, 3.0, 1.0, 9.0], dtype=torch.float64)  # the running world's 9 not counted
+    expected = curriculum(start=0.03, target=2.0).update(sizes, ended)
+    assert float(env.task_state.radius) == pytest.approx(float(expected)) and float(expected) < 0.0295
+    by_rotations = roto.make("baoding", robot="allegro", num_envs=4, seed=0, aids=TOLERANCE)
+    by_rotations.reset()
+    by_rotations.task_state.net_turn.copy_(env.task_state.net_turn)
+    by_rotations.aid(ToleranceAid).observe(
+        StepContext(None, None, None, by_rotations.task_state, no_rotations, None, ended)
+    )
+    assert float(by_rotations.task_state.radius) == pytest.approx(0.03)  # no rotation: still wide
+
+
 @pytest.mark.parametrize(
     ("task", "settings", "pattern"),
     [
@@ -77,14 +100,26 @@ def test_a_baoding_env_starts_wide_narrows_as_its_episodes_rotate_and_resumes_ex
             {"start": 0.005},
             r"aids.tolerance.start must be a radius \(m\) no smaller than the task's own 0.01",
         ),
-        ("baoding", {"start": 0.02, "target": 0.0}, r"aids.tolerance.target must be a headline metric.*got 0.0"),
+        ("baoding", {"start": 0.02, "target": 0.0}, r"aids.tolerance.target must be a mean of headline.*got 0.0"),
         ("baoding", {"start": -1.0}, r"got -1.0"),
         ("baoding", {"target": 2.0}, r"aids.tolerance needs \['start'\]"),
+        (
+            "baoding",
+            {"start": 0.02, "by": "swaps"},
+            r"tolerance.by must be one of \['headline', 'net_turns'\], got 'swaps'",
+        ),
     ],
 )
 def test_bad_tolerance_settings_are_refused(task, settings, pattern):
     with pytest.raises(ValueError, match=pattern):
         EnvConfig(task=task, aids={"tolerance": settings})
+
+
+def test_net_turns_need_a_ball_pair():
+    latch_only = SimpleNamespace(name="latch", parameters={"success_radius": SUCCESS_RADIUS})
+    ToleranceSettings(start=0.02).check("aids.tolerance", latch_only)
+    with pytest.raises(ValueError, match=r"aids.tolerance.by applies to a task with a ball pair.*'latch' has none"):
+        ToleranceSettings(start=0.02, by="net_turns").check("aids.tolerance", latch_only)
 
 
 def test_evaluation_envs_use_the_benchmarks_radius():
@@ -122,5 +157,5 @@ def test_training_logs_the_radius_and_config_yaml_names_the_aid(tmp_path):
     ]
     assert len(radii) == 3 and all(SUCCESS_RADIUS <= r <= 0.03 for r in radii)
     assert yaml.safe_load((run_dir / "config.yaml").read_text())["env"]["aids"] == {
-        "tolerance": {"start": 0.03, "target": 1.0}
+        "tolerance": {"start": 0.03, "target": 1.0, "by": "headline"}
     }
