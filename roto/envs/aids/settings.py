@@ -100,9 +100,9 @@ class ToleranceSettings:
         _needs_parameter(path, task, "success_radius", "a success radius")
         own = task.parameters["success_radius"]
         _number(f"{path}.start", self.start, own, 1.0, f"a radius (m) no smaller than the task's own {own}")
-        _number(f"{path}.target", self.target, 1e-9, 1e6, f"a mean of {self.by} per episode")
         if self.by not in TOLERANCE_MEASURES:
             raise ValueError(f"{path}.by must be one of {list(TOLERANCE_MEASURES)}, got {self.by!r}")
+        _number(f"{path}.target", self.target, 1e-9, 1e6, f"a mean of {self.by} per episode")
         if self.by == "net_turns":
             _needs_parameter(f"{path}.by", task, "turn_reward", "a ball pair")
 
