@@ -1,5 +1,6 @@
 """The tolerance curriculum: Baoding's latch radius starts wide, narrows as training episodes
-rotate, is saved with the env, is refused where a task has no radius, and never reaches evaluation."""
+rotate (or, by net turns, as the pair turns), is saved with the env, is refused where a task has no
+radius, and never reaches evaluation."""
 
 from types import SimpleNamespace
 
