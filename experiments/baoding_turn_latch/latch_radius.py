@@ -1,6 +1,6 @@
 """When each blind Baoding seed's training latch radius (the tolerance curriculum's) reached the
-task's 1 cm, and the radius with the training episodes' rotations at fixed env steps, read from
-committed cell summaries.
+task's 1 cm, the widest it was from then on, and the radius with the training episodes' rotations
+at fixed env steps, read from committed cell summaries.
 
     python experiments/baoding_turn_latch/latch_radius.py experiments/baoding_hold_every_hand/results/*.json
 """
@@ -26,6 +26,9 @@ def describe(summary: dict) -> str:
             row = nearest(training, m * 1e6)
             marks.append(f"{m:g} M {100 * row['train/success_radius']:.2f} cm / {row['train/episode_rotations']:.2f}")
     reached = f"{narrowed:.2f} M" if narrowed is not None else "not reached"
+    if narrowed is not None:
+        after = [r["train/success_radius"] for r in training if r["env_steps"] >= narrowed * 1e6]
+        reached += f" (widest from then on {100 * max(after):.2f} cm)"
     best = summary["best"]["round_rotations_mean"]
     return f"{summary['robot']} seed {summary['seed']} (best {best:.2f}): 1 cm {reached}; " + ", ".join(marks)
 

@@ -354,7 +354,7 @@ def test_the_shadows_more_aids_cell_is_the_other_hands_recipe_and_adds_two_aids_
     assert three.differences(one) == {
         "env.aids.replayed_starts.share": (0.5, 0.25),
         "env.aids.replayed_starts.record_lead": (10, 0),
-        "env.aids.tolerance": ({"start": 0.025, "target": 2, "by": "headline"}, None),
+        "env.aids.tolerance": ({"start": 0.025, "target": 2, "by": "headline", "deadline": None}, None),
     }
 
 
@@ -368,11 +368,12 @@ def test_each_ablation_changes_exactly_its_part_of_the_baoding_recipe():
     assert recipe.differences(cell_spec(main, Cell("baoding", "shadow", "blind", "task_critic_more_aids", 1))) == {}
     bank = "shadow_preswap"
     replayed = {"bank": bank, "share": 0.5, "record_lead": 10, "record_capacity": 1024}
+    tolerance = {"start": 0.025, "target": 2, "by": "headline", "deadline": None}
     expected = {
         "recipe": {},
         "no_replay": {"env.aids.replayed_starts": (None, replayed)},
         "no_own_swaps": {"env.aids.replayed_starts.record_lead": (0, 10)},
-        "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2, "by": "headline"})},
+        "no_tolerance": {"env.aids.tolerance": (None, tolerance)},
         "plain_critic": {"agent.network.critic": (None, ["tactile", "proprio", "privileged", "task"])},
         "roto_epochs": {"agent.ppo.epochs": (8, 4)},
         "std_bound": {"agent.network.max_log_std": (0.0, 2.0)},
@@ -651,7 +652,9 @@ def test_each_part_of_baoding_cpu_is_switched_off_by_exactly_one_ablation():
         "no_turn_shaping": {"env.aids.turn_shaping": (None, TURN_SHAPING)},
         "no_replayed_starts": {"env.aids.replayed_starts": (None, replayed)},
         "no_recording": {"env.aids.replayed_starts.record_lead": (0, 10)},
-        "no_tolerance": {"env.aids.tolerance": (None, {"start": 0.025, "target": 2, "by": "headline"})},
+        "no_tolerance": {
+            "env.aids.tolerance": (None, {"start": 0.025, "target": 2, "by": "headline", "deadline": None})
+        },
         "std_1": {"agent.network.init_log_std": (0.0, -1.386), "agent.network.max_log_std": (0.0, -1.386)},
         "plain_critic": {"agent.network.critic": (None, ["tactile", "proprio", "privileged", "task"])},
     }
@@ -770,6 +773,13 @@ def test_the_turn_latch_probe_is_turn_focus_with_the_latch_narrowing_by_net_turn
     }
     plan = assert_baoding_cpu_cells_but("turn_latch", [("allegro", 1), ("allegro", 3)], focus)
     assert plan.steps == 20_000_000
+
+
+def test_the_latch_deadline_probe_is_the_allegros_baoding_cpu_with_only_a_deadline():
+    """experiments/baoding_latch_deadline: the Allegro's cells with the latch at 1 cm from 5 M on."""
+    deadline = {"env.aids.tolerance.deadline": (5_000_000, None)}
+    plan = assert_baoding_cpu_cells_but("latch_deadline", [("allegro", 0), ("allegro", 4)], deadline)
+    assert plan.steps == 10_000_000
 
 
 def test_the_drop_penalty_study_is_the_benchmarks_bounce_cells_with_only_the_aid():

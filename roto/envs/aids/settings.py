@@ -90,11 +90,14 @@ class ToleranceSettings:
             at a wide radius can hold it wide); ``net_turns``, the size of the ball pair's net
             turning, which no radius changes (Baoding), so the radius narrows as the policy learns
             to turn the pair wherever it turns it.
+        deadline: None: none; else training env steps (every world's control steps together)
+            from which the radius is the task's own whatever the episodes score.
     """
 
     start: float
     target: float = 1.0
     by: str = "headline"
+    deadline: int | None = None
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "success_radius", "a success radius")
@@ -105,6 +108,8 @@ class ToleranceSettings:
         _number(f"{path}.target", self.target, 1e-9, 1e6, f"a mean of {self.by} per episode")
         if self.by == "net_turns":
             _needs_parameter(f"{path}.by", task, "turn_reward", "a ball pair")
+        if self.deadline is not None:
+            _count(f"{path}.deadline", self.deadline, 1)
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -16,7 +16,7 @@ def test_the_section_reads_plain_data_and_writes_back_only_the_aids_that_are_on(
     aids = parse_aids({"round_swaps": {}, "tolerance": {"start": 0.02}, "turn_shaping": None})
     assert aids.active() == {"tolerance": aids.tolerance, "round_swaps": RoundSwapsSettings(min_turn=0.25)}
     assert aids.to_dict() == {
-        "tolerance": {"start": 0.02, "target": 1.0, "by": "headline"},
+        "tolerance": {"start": 0.02, "target": 1.0, "by": "headline", "deadline": None},
         "round_swaps": {"min_turn": 0.25, "first_paid": False, "after": None},
     }
     assert parse_aids(aids.to_dict()) == aids and parse_aids(None) == AidsConfig() == parse_aids({})

@@ -92,6 +92,35 @@ def test_by_net_turns_the_radius_narrows_as_the_pair_turns_with_no_latch_counted
     assert float(by_rotations.task_state.radius) == pytest.approx(0.03)  # no rotation: still wide
 
 
+def test_past_its_deadline_the_radius_is_the_tasks_own_whatever_the_episodes_score_and_resumes():
+    aids = {"tolerance": {"start": 0.03, "target": 2.0, "deadline": 12}}
+    env = roto.make("baoding", robot="allegro", num_envs=4, seed=0, aids=aids)
+    env.reset()
+    aid = env.aid(ToleranceAid)
+    none_ended = torch.zeros(4, dtype=torch.bool)
+    no_rotations = torch.zeros(4, dtype=torch.float64)
+    step = StepContext(None, None, None, env.task_state, no_rotations, None, none_ended)
+    for _ in range(2):  # 8 of the 12 env steps: still the curriculum's, wide with no rotation
+        aid.observe(step)
+    assert float(env.task_state.radius) == pytest.approx(0.03)
+    assert float(aid.metrics()["train/success_radius"]) == pytest.approx(0.03)
+    saved = env.state_dict()
+    aid.observe(step)  # 12 env steps: the deadline
+    assert float(env.task_state.radius) == SUCCESS_RADIUS
+    assert float(aid.metrics()["train/success_radius"]) == SUCCESS_RADIUS
+    assert float(aid.curriculum.value()) == pytest.approx(0.03)  # the curriculum itself still wide
+    resumed = roto.make("baoding", robot="allegro", num_envs=4, seed=3, aids=aids)
+    resumed.load_state_dict(saved)
+    resumed.aid(ToleranceAid).observe(StepContext(None, None, None, resumed.task_state, no_rotations, None, none_ended))
+    assert resumed.aid(ToleranceAid).env_steps == 12 and float(resumed.task_state.radius) == SUCCESS_RADIUS
+    without = roto.make("baoding", robot="allegro", num_envs=4, seed=0, aids=TOLERANCE)
+    for _ in range(100):  # no deadline: the radius follows the episodes alone
+        without.aid(ToleranceAid).observe(
+            StepContext(None, None, None, without.task_state, no_rotations, None, none_ended)
+        )
+    assert float(without.task_state.radius) == pytest.approx(0.03)
+
+
 @pytest.mark.parametrize(
     ("task", "settings", "pattern"),
     [
@@ -108,6 +137,12 @@ def test_by_net_turns_the_radius_narrows_as_the_pair_turns_with_no_latch_counted
             "baoding",
             {"start": 0.02, "by": "swaps"},
             r"tolerance.by must be one of \['headline', 'net_turns'\], got 'swaps'",
+        ),
+        ("baoding", {"start": 0.02, "deadline": 0}, r"aids.tolerance.deadline must be an integer >= 1, got 0"),
+        (
+            "baoding",
+            {"start": 0.02, "deadline": 5e6},
+            r"aids.tolerance.deadline must be an integer >= 1, got 5000000.0",
         ),
     ],
 )
@@ -158,5 +193,5 @@ def test_training_logs_the_radius_and_config_yaml_names_the_aid(tmp_path):
     ]
     assert len(radii) == 3 and all(SUCCESS_RADIUS <= r <= 0.03 for r in radii)
     assert yaml.safe_load((run_dir / "config.yaml").read_text())["env"]["aids"] == {
-        "tolerance": {"start": 0.03, "target": 1.0, "by": "headline"}
+        "tolerance": {"start": 0.03, "target": 1.0, "by": "headline", "deadline": None}
     }
