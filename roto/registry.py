@@ -93,8 +93,8 @@ def register_gymnasium_envs() -> None:
             continue
         gymnasium.register(
             id=env_id,
-            entry_point="roto.envs.gym_adapters:RotoSingleEnv",
-            vector_entry_point="roto.envs.gym_adapters:RotoVectorEnv",
+            entry_point="roto.wrappers.gymnasium_envs:RotoSingleEnv",
+            vector_entry_point="roto.wrappers.gymnasium_envs:RotoVectorEnv",
             kwargs={"task": task, "robot": robot, "env_id": env_id},
             disable_env_checker=True,
         )

@@ -38,12 +38,13 @@ def test_no_function_is_over_60_lines():
 
 
 LAYERS = {
-    "envs": ("roto.rl", "roto.eval", "roto.sweep", "roto.olympiad"),
+    "envs": ("roto.rl", "roto.eval", "roto.sweep", "roto.olympiad", "roto.registry", "roto.wrappers"),
     "rl": ("roto.eval", "roto.sweep", "roto.olympiad"),
     "jobs": ("roto.envs", "roto.eval", "roto.sweep", "roto.olympiad"),
 }
 """Packages and what they must never import: data flows up, from the envs to the learner to what
-evaluates, sweeps and tabulates it."""
+evaluates, sweeps and tabulates it; the registry (``roto.make``) and the adapters for other
+libraries stand on the envs."""
 
 
 def imported_modules(path: pathlib.Path) -> set[str]:

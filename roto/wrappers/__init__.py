@@ -1,1 +1,2 @@
-"""Adapters that hand roto's batched environments to other learning libraries (optional extras)."""
+"""Adapters that hand roto's batched environments to Gymnasium (its registered ids) and to other learning
+libraries (optional extras)."""
