@@ -261,7 +261,9 @@ def variants_table(summaries: list[dict], baseline: str, plan: Plan | None = Non
     seed), seeds by path (Baoding), and against the baseline on the seeds both trained: the mean
     paired difference with its 95 % bootstrap interval (three shared seeds or more) and how many
     seeds did better and worse. A change is judged on the same seeds, seed by seed, not only by
-    its mean."""
+    its mean. With ``plan``, only the variants it trains: a folder may hold another study's cells."""
+    if plan is not None:
+        summaries = [s for s in summaries if s["variant"] in plan.variants]
     head = ["task", "hand", "obs", "variant", "agent config", "seeds", "mean ± std", "per seed", "seeds by path"]
     head += [f"seeds shared with {baseline}", "paired difference [95 % CI]", "seeds better / worse"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]

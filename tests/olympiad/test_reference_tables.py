@@ -293,6 +293,10 @@ def test_a_block_labels_each_variant_from_whichever_of_its_plans_trains_it(tmp_p
         ("bank", "`baoding_cpu`"),
         ("other_seeds", "`baoding_cpu_v1`"),
     ]
+    only_bank = plan_file(tmp_path / "three.yaml", {"base": "baoding_cpu_v1", "bank": "baoding_cpu"})
+    text = f"<!-- roto results: variants s plan={only_bank} baseline=base -->\n<!-- /roto results -->\n"
+    rows = [line.split(" | ") for line in refresh_blocks(text, tmp_path).splitlines() if line.startswith("| baoding")]
+    assert [row[3] for row in rows] == ["base", "bank"]  # other_seeds: a variant no plan of the block trains
     clash = plan_file(tmp_path / "clash.yaml", {"base": "baoding_cpu"})
     with pytest.raises(ValueError, match="both have a variant 'base', trained differently"):
         refresh_blocks(
