@@ -170,6 +170,7 @@ def dry_run_report(
     """The cells and their status, and the time left for the env steps left (a started cell counts
     the env steps of its run's last evaluation; ``time_left_estimate``). ``whole``: the plan
     ``--only`` chose ``plan``'s cells from, whose finished cells give the throughput."""
+    from roto.jobs.storage import journal_of
     from roto.olympiad.time_left import recent_rate
     from roto.olympiad.worker import cell_status
     from roto.rl.evaluation import read_evaluations
@@ -193,6 +194,9 @@ def dry_run_report(
         budget = "" if uniform else f" [{budgets[name] / 1e6:g} M]"
         lines.append(f"  {name:<52} {state}{budget}{progress}")
     left = sum(state != "done" for state in status.values())
+    journal = journal_of(pathlib.Path(root) / plan.name, storage)
+    if left and journal is not None and not journal.is_file():
+        lines += ["", f"no workers' journal at {journal}: a cell running under another --root shows as not started"]
     steps_left = {name: budgets[name] - done_steps[name] for name, state in status.items() if state != "done"}
     lines += ["", f"{len(status) - left} done, {left} left; time left: "]
     lines[-1] += time_left_estimate(whole or plan, results, steps_left, started_rates, workers)

@@ -127,6 +127,9 @@ def test_dry_run_lists_cells_and_estimates_the_time_left_from_finished_cells(tmp
     # at 10 M: 560 M steps at 5000 env steps/s = 112000 s
     assert "1 done, 79 left; time left: 31.1 h for one worker at bounce 5000, baoding 5000 env steps/s" in out
     assert "(the finished cells' throughput per task; baoding at all the finished cells' throughput)" in out
+    assert (
+        f"no workers' journal at {tmp_path / 'benchmark' / 'journal.log'}: a cell running under another --root" in out
+    )
     assert not (tmp_path / "benchmark").exists()  # a dry run creates no study
     started = tmp_path / "benchmark" / "bounce-allegro-blind-ppo-seed0"  # a cell's run, 2.5 M steps in
     started.mkdir(parents=True)
