@@ -26,7 +26,7 @@ from roto.envs.observations import OBS_MODES
 from roto.olympiad.cell import cell_spec
 from roto.olympiad.path_results import kind_counts, measure_scores, seed_measures, seed_path_kind, with_derived_means
 from roto.olympiad.plan import Cell, Plan, load_plan
-from roto.olympiad.results import cell_statistics, read_summaries
+from roto.olympiad.results import cell_statistics, lead_measure, read_summaries
 from roto.olympiad.stats import difference_ci, paired_difference_ci
 from roto.robots import ROBOTS
 from roto.tasks import TASKS, get_task
@@ -43,12 +43,6 @@ PUBLISHED = {
 v1's PPO (mean of 5 seeds) and the roto 2.0 paper; other agents than roto's, set beside ours."""
 
 Row = tuple[str, str, str]  # robot, obs, variant
-
-
-def lead_measure(task: str) -> str:
-    """The measure a task's results lead with: its selection metric, else its headline metric."""
-    spec = get_task(task)
-    return spec.selection_metric or spec.headline_metric
 
 
 def _row_order(row: Row) -> tuple[int, int, str]:

@@ -51,6 +51,19 @@ def metric(task: str) -> str:
     return get_task(task).headline_metric
 
 
+def lead_measure(task: str) -> str:
+    """The measure a task's results lead with: its selection metric, else its headline metric."""
+    spec = get_task(task)
+    return spec.selection_metric or spec.headline_metric
+
+
+def page_label(summaries: list[dict], plan: str = "") -> str:
+    """ "plan <name>, commit <c1>, <c2>" of a folder of summaries (``plan``: a name or file that wins
+    over the plan the summaries record)."""
+    commits = sorted({s["commit"] for s in summaries})
+    return f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
+
+
 def variant_agents(summaries: list[dict], plan: str = "") -> Agents:
     """What each (task, variant) trained: from the plan when ``plan`` names a packaged plan or a
     file, else from the summaries (which record it), else only the variant's name."""
@@ -293,23 +306,41 @@ def action_std_records(summary: dict) -> list[dict]:
     ]
 
 
-def plot_curves(summaries: list[dict], out: pathlib.Path, label: str) -> list[pathlib.Path]:
-    """Per (task, robot): evaluation metric against env steps and training wall time, mean over
-    seeds with a min-max band, one line per (obs mode, variant); and, where summaries keep it,
-    the policy's action std in training against env steps (``action_std_<task>_<robot>.png``)."""
+def curve_measure(task: str, curves: dict[str, list[list[dict]]]) -> str:
+    """What a (task, robot)'s curves plot: the task's lead measure (``lead_measure``: Baoding's round
+    rotations) where every evaluation record of every run has its mean, else its headline metric
+    (summaries written before evaluations measured the lead)."""
+    lead = lead_measure(task)
+    runs = [records for seeds in curves.values() for records in seeds]
+    return lead if all(f"{lead}_mean" in r for records in runs for r in records) else metric(task)
+
+
+def plot_curves(summaries: list[dict], out: pathlib.Path, plan: str = "") -> list[pathlib.Path]:
+    """Per (task, robot): evaluation lead measure (``curve_measure``) against env steps and training
+    wall time, mean over seeds with a min-max band, one line per (obs mode, variant); and, where
+    summaries keep it, the policy's action std in training against env steps
+    (``action_std_<task>_<robot>.png``). Each title names ``plan`` (else the summaries' plan) and
+    the commits of that plot's own runs, so a plot changes only when its runs do."""
     paths = []
     for (task, robot), curves in curves_by_pair(summaries, lambda s: s["evaluations"]).items():
         path = out / f"curves_{task}_{robot}.png"
-        plot_variants(curves, metric(task), path, title=f"{task} / {robot} ({label})", xs=("env_steps", "train_wall_s"))
+        title = f"{task} / {robot} ({page_label(pair_summaries(summaries, task, robot), plan)})"
+        plot_variants(curves, curve_measure(task, curves), path, title=title, xs=("env_steps", "train_wall_s"))
         paths.append(path)
     for (task, robot), curves in curves_by_pair(summaries, action_std_records).items():
         path = out / f"action_std_{task}_{robot}.png"
+        kept = [s for s in pair_summaries(summaries, task, robot) if action_std_records(s)]
         plot_variants(
             curves,
             "action_std",
             path,
-            title=f"{task} / {robot} ({label})",
+            title=f"{task} / {robot} ({page_label(kept, plan)})",
             ylabel="policy's action std in training (mean over seeds)",
         )
         paths.append(path)
     return paths
+
+
+def pair_summaries(summaries: list[dict], task: str, robot: str) -> list[dict]:
+    """The summaries of one (task, robot)."""
+    return [s for s in summaries if s["task"] == task and s["robot"] == robot]

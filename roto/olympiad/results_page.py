@@ -13,6 +13,7 @@ from roto.olympiad.results import (
     current_tasks,
     improvements,
     markdown_table,
+    page_label,
     plot_curves,
     read_summaries,
     scores_by_cell,
@@ -21,13 +22,6 @@ from roto.olympiad.results import (
 )
 from roto.olympiad.submission import with_submissions
 from roto.result_files import write_text_atomic
-
-
-def page_label(summaries: list[dict], plan: str = "") -> str:
-    """ "plan <name>, commit <c1>, <c2>" of a folder of summaries (``plan``: a name or file that wins
-    over the plan the summaries record)."""
-    commits = sorted({s["commit"] for s in summaries})
-    return f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
 
 
 def results_markdown(summaries: list[dict], plan: str = "") -> str:
@@ -65,5 +59,5 @@ def write_results(
     for policy in ("final", "best"):
         write_csv(scores_by_cell(summaries, policy), out / f"results_{policy}.csv", policy)
     write_text_atomic(out / "results.md", results_markdown(summaries, name))
-    plots = plot_curves(summaries, out, page_label(summaries, name))
+    plots = plot_curves(summaries, out, name)
     return {"markdown": str(out / "results.md"), "plots": [str(p) for p in plots], "cells": len(summaries)}

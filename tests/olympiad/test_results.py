@@ -59,6 +59,30 @@ def test_results_match_hand_computed_statistics(tmp_path, capsys):
     assert not (out / "action_std_bounce_shadow.png").exists()
 
 
+def test_baoding_curves_plot_round_rotations_where_every_record_has_them():
+    from roto.olympiad.results import curve_measure
+
+    measured = {"blind / ppo": [[{"rotations_mean": 3.0, "round_rotations_mean": 0.2}] * 2]}
+    assert curve_measure("baoding", measured) == "round_rotations"
+    older = {**measured, "state / ppo": [[{"rotations_mean": 3.0}]]}  # a run before paths were measured
+    assert curve_measure("baoding", older) == "rotations"
+    assert curve_measure("bounce", {"blind / ppo": [[{"bounces_mean": 1.0}]]}) == "bounces"
+
+
+def test_each_curve_title_names_only_its_own_runs_commits(tmp_path, monkeypatch):
+    from roto.olympiad import results
+
+    write_summaries(tmp_path / "summaries")
+    late = tmp_path / "summaries" / "baoding-allegro-blind-ppo-seed0.json"
+    late.write_text(json.dumps({**json.loads(late.read_text()), "commit": "def5678"}))
+    titles = {}
+    monkeypatch.setattr(results, "plot_variants", lambda c, m, path, title, **kw: titles.setdefault(path.name, title))
+    results.plot_curves(results.read_summaries(tmp_path / "summaries"), tmp_path, "benchmark")
+    assert titles["curves_bounce_shadow.png"] == "bounce / shadow (plan benchmark, commit abc1234)"
+    assert titles["curves_baoding_allegro.png"] == "baoding / allegro (plan benchmark, commit def5678)"
+    assert titles["action_std_baoding_allegro.png"] == titles["curves_baoding_allegro.png"]
+
+
 def test_one_seed_gets_no_spread_and_no_probability_of_improvement(tmp_path):
     from roto.olympiad.results_page import write_results
 
