@@ -120,7 +120,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 130
-    plot_learning_curve(trainer.run_dir)
+    plot_learning_curve(trainer.run_dir, selection_metric=trainer.env.task.selection_metric)
     summary = {"run_dir": str(trainer.run_dir), "env_steps": trainer.env_steps, "updates": trainer.update}
     summary.update(lead_first(last, trainer.env.task.selection_metric))
     summary["spec"] = trainer.spec.to_dict()

@@ -9,7 +9,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from roto.result_files import replacing
-from roto.rl.evaluation import read_evaluations
+from roto.rl.evaluation import best_eval_key, read_evaluations
 
 
 def curve_metrics(records: Sequence[Mapping]) -> list[str]:
@@ -18,8 +18,20 @@ def curve_metrics(records: Sequence[Mapping]) -> list[str]:
     return sorted((n for n in names if n != "length"), key=lambda n: (n != "return", n))
 
 
-def plot_learning_curve(run_dir: str | pathlib.Path, out: str | pathlib.Path | None = None) -> pathlib.Path | None:
-    """Evaluation mean ± std of the return and each task metric against env steps, best marked.
+def best_evaluation(records: Sequence[Mapping], selection_metric: str | None = None) -> int:
+    """The index of the evaluation ``best.pt`` holds: ranked as training ranks them (``best_eval_key``:
+    the task's ``selection_metric``, Baoding's round rotations, then the return; the return alone
+    where the task has none or the records predate it), the first of equals."""
+    metric = selection_metric if selection_metric and f"{selection_metric}_mean" in records[0] else None
+    keys = [best_eval_key(dict(r), metric) for r in records]
+    return max(range(len(keys)), key=lambda i: (keys[i], -i))
+
+
+def plot_learning_curve(
+    run_dir: str | pathlib.Path, out: str | pathlib.Path | None = None, selection_metric: str | None = None
+) -> pathlib.Path | None:
+    """Evaluation mean ± std of the return and each task metric against env steps, ``best.pt``'s
+    evaluation marked (``best_evaluation`` by the task's ``selection_metric``).
 
     Writes ``<run_dir>/learning_curve.png`` unless ``out`` is given; returns the path, or None when
     the run has no evaluation yet.
@@ -31,7 +43,7 @@ def plot_learning_curve(run_dir: str | pathlib.Path, out: str | pathlib.Path | N
     run_dir = pathlib.Path(run_dir)
     metrics = curve_metrics(records)
     steps = np.array([r["env_steps"] for r in records])
-    best = int(np.argmax([r["return_mean"] for r in records]))
+    best = best_evaluation(records, selection_metric)
     fig, axes = plt.subplots(1, len(metrics), figsize=(5 * len(metrics), 3.6), squeeze=False)
     for ax, name in zip(axes[0], metrics, strict=True):
         mean = np.array([r[f"{name}_mean"] for r in records])
