@@ -159,8 +159,9 @@ def headline_so_far(records: list[dict], metric: str, path_metrics: tuple[str, .
 def status_metrics(task: Task, records: list[dict]) -> tuple[str, tuple[str, ...]]:
     """(the measure a run's status leads with, the others beside it): the task's selection metric
     (Baoding: round rotations, roto's count beside it) where its records have it, else the headline."""
-    measured = task.selection_metric and any(f"{task.selection_metric}_mean" in r for r in records)
-    lead = task.selection_metric if measured else task.headline_metric
+    from roto.tasks.base import lead_metric
+
+    lead = lead_metric(task, records)
     return lead, tuple(m for m in (task.headline_metric, *task.path_metric_names) if m != lead)
 
 

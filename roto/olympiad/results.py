@@ -27,6 +27,7 @@ from roto.olympiad.stats import iqm, probability_of_improvement, stratified_boot
 from roto.result_files import read_json, replacing
 from roto.robots import ROBOTS
 from roto.tasks import get_task
+from roto.tasks.base import lead_metric
 
 ROTO_V1_SHADOW = {
     ("bounce", "blind", "ppo"): 69.0,
@@ -53,8 +54,7 @@ def metric(task: str) -> str:
 
 def lead_measure(task: str) -> str:
     """The measure a task's results lead with: its selection metric, else its headline metric."""
-    spec = get_task(task)
-    return spec.selection_metric or spec.headline_metric
+    return lead_metric(get_task(task))
 
 
 def page_label(summaries: list[dict], plan: str = "") -> str:
@@ -310,9 +310,7 @@ def curve_measure(task: str, curves: dict[str, list[list[dict]]]) -> str:
     """What a (task, robot)'s curves plot: the task's lead measure (``lead_measure``: Baoding's round
     rotations) where every evaluation record of every run has its mean, else its headline metric
     (summaries written before evaluations measured the lead)."""
-    lead = lead_measure(task)
-    runs = [records for seeds in curves.values() for records in seeds]
-    return lead if all(f"{lead}_mean" in r for records in runs for r in records) else metric(task)
+    return lead_metric(get_task(task), [r for seeds in curves.values() for records in seeds for r in records])
 
 
 def plot_curves(summaries: list[dict], out: pathlib.Path, plan: str = "") -> list[pathlib.Path]:

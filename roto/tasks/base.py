@@ -8,7 +8,7 @@ code: it uses operators, indexing, ``sum``/``any``/``all(axis=...)`` and ``roto.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -149,6 +149,14 @@ class Task(Protocol):
         seeds by (Baoding: "round", "swing" or "no swaps"); None for a task without such kinds
         or where ``means`` lacks what the kind needs."""
         ...
+
+
+def lead_metric(task: Task, records: Iterable[Mapping] = ()) -> str:
+    """The measure ``task``'s reports lead with: its ``selection_metric`` (Baoding: round rotations)
+    where every one of ``records`` (evaluation records) holds its mean, else its headline metric (a
+    task without one, or records from before it was measured)."""
+    lead = task.selection_metric
+    return lead if lead and all(f"{lead}_mean" in r for r in records) else task.headline_metric
 
 
 def uniform(
