@@ -5,9 +5,11 @@ The run directory is ``<root>/<plan>/<cell>`` (an ordinary run: ``roto eval``, `
 summary, ``<results>/<cell>.json``, is small enough to commit: the evaluation curve, the training
 scalars between evaluations (the policy's action std, the training episodes' return, length and
 task metrics), the training aids its run used, the final and best policies' evaluations over the
-plan's episodes (per-episode returns and task metrics included), the training wall time and the
-commit. ``roto results`` reads
-only summaries, so cells trained on other machines or in other sittings combine.
+plan's episodes (per-episode returns and task metrics included), the training wall time, the
+commit that wrote it and the commits that trained it: each start of training appends its commit
+and the env steps it started from to ``<run_dir>/commits.jsonl`` (``TRAINED_BY``), so a cell
+resumed across commits names each. ``roto results`` reads only summaries, so cells trained on
+other machines or in other sittings combine.
 """
 
 from __future__ import annotations
@@ -51,6 +53,24 @@ def code_commit() -> str:
     except OSError:  # no git on this machine
         return "unknown"
     return out.stdout.strip() if out is not None and out.returncode == 0 and out.stdout.strip() else "unknown"
+
+
+TRAINED_BY = "commits.jsonl"
+"""A run directory's record of the commits that trained it: one JSON line per start of training."""
+
+
+def record_training_start(run_dir: pathlib.Path, commit: str, from_env_steps: int) -> None:
+    """Append ``{"commit", "from_env_steps"}`` to the run's ``TRAINED_BY`` (a start that trains)."""
+    with (run_dir / TRAINED_BY).open("a") as f:
+        f.write(json.dumps({"commit": commit, "from_env_steps": from_env_steps}) + "\n")
+
+
+def trained_by(run_dir: pathlib.Path) -> list[dict[str, Any]]:
+    """The run's training starts, oldest first ([] where none was recorded: a run trained before
+    roto kept the record, or outside a plan); a run whose first start is above 0 env steps was
+    trained before that by code the record does not name."""
+    path = run_dir / TRAINED_BY
+    return [json.loads(line) for line in path.read_text().splitlines() if line] if path.is_file() else []
 
 
 TRAINING_SCALARS = ("ppo/action_std",)  # besides every ``train/...`` scalar (the training episodes')
@@ -116,6 +136,8 @@ def run_cell(
     """Train (or continue) the cell, evaluate it, write and return its summary."""
     wait_until_free(run_dir)  # a retry of a cell whose first worker, declared dead, is still training it
     with Trainer.open(run_dir, cell_spec(plan, cell), env_factory=env_factory) as trainer:
+        if trainer.update < trainer.total_updates:
+            record_training_start(run_dir, commit, trainer.env_steps)
         trainer.train(progress=False)
     final = copy.deepcopy(trainer.model).cpu().eval()
     best = copy.deepcopy(final)
@@ -130,6 +152,7 @@ def run_cell(
         "agent": agent_record(plan, cell),
         "training_aids": trainer.spec.env.aids.to_dict(),
         "commit": commit,
+        "trained_by": trained_by(run_dir),
         "run_dir": str(run_dir),
         "env_steps": trainer.env_steps,
         "train_wall_s": trainer.train_seconds,

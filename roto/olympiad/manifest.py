@@ -1,5 +1,5 @@
 """A results folder's manifest: one row per cell summary naming what made it (config, training
-aids, commit, task version), written by ``roto results`` beside the tables."""
+aids, the commits that trained and summarised it, task version), written by ``roto results`` beside the tables."""
 
 from __future__ import annotations
 
@@ -23,6 +23,7 @@ COLUMNS = (
     "env_steps",
     "train_wall_s",
     "commit",
+    "trained_by",
     "plan",
 )
 
@@ -35,8 +36,16 @@ def manifest_rows(summaries: list[dict], plan: Plan | None = None) -> list[dict[
         cell = f"{s['task']}-{s['robot']}-{s['obs']}-{s['variant']}-seed{s['seed']}"
         row = {key: str(s.get(key, "not recorded")) for key in COLUMNS}
         row.update(cell=cell, config=config_label(s, plan), training_aids=training_aids(s, plan))
+        row.update(trained_by=trained_by_label(s))
         rows.append(row)
     return sorted(rows, key=lambda row: row["cell"])
+
+
+def trained_by_label(summary: dict) -> str:
+    """The commits that trained a cell, each with the env steps it started from ("c1 from 0; c2 from
+    8396800"); "not recorded" for a summary without the record (``roto.olympiad.cell.trained_by``)."""
+    starts = summary.get("trained_by") or []
+    return "; ".join(f"{t['commit']} from {t['from_env_steps']}" for t in starts) or "not recorded"
 
 
 def write_manifest(summaries: list[dict], path: pathlib.Path, plan: Plan | None = None) -> None:

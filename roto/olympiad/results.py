@@ -58,9 +58,9 @@ def lead_measure(task: str) -> str:
 
 
 def page_label(summaries: list[dict], plan: str = "") -> str:
-    """ "plan <name>, commit <c1>, <c2>" of a folder of summaries (``plan``: a name or file that wins
-    over the plan the summaries record)."""
-    commits = sorted({s["commit"] for s in summaries})
+    """ "plan <name>, commit <c1>, <c2>" of a folder of summaries: the commits that wrote them and
+    those that trained them (``plan``: a name or file that wins over the plan the summaries record)."""
+    commits = sorted({c for s in summaries for c in (s["commit"], *(t["commit"] for t in s.get("trained_by", [])))})
     return f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
 
 

@@ -136,6 +136,10 @@ def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_p
     assert turn["config"] == "baoding_cpu_shadow + turn" and turn["training_aids"] == "tolerance, turn_shaping"
     assert turn["task_version"] == "not recorded" and rows["bounce-allegro-state-ppo-seed0"]["task_version"] == "0"
     assert turn["commit"] == "abc1234" and list(rows) == sorted(rows)
+    assert turn["trained_by"] == "not recorded"  # a summary written before the record
+    resumed = summary("bounce", "orca", "blind", "ppo", 0, {"bounces_mean": 1.0})
+    resumed["trained_by"] = [{"commit": "aaa1111", "from_env_steps": 0}, {"commit": "abc1234", "from_env_steps": 64}]
+    assert manifest_rows([resumed])[0]["trained_by"] == "aaa1111 from 0; abc1234 from 64"
     write_folder(tmp_path / "cells", SUMMARIES)
     assert main(["results", str(tmp_path / "cells"), "--out", str(tmp_path / "out")]) == 0
     written = list(csv.DictReader((tmp_path / "out" / "manifest.csv").open()))

@@ -155,6 +155,27 @@ def test_a_finished_cell_whose_summary_is_taken_away_continues_to_the_plans_long
     assert set(cell_status(plan, str(root), results, None).values()) == {"done"}
 
 
+def test_a_summary_names_each_commit_that_trained_its_cell_and_where_each_started(tmp_path):
+    """A cell resumed by code of another commit: both commits and the env steps each took over at;
+    a start that only evaluates (its budget spent) trains nothing and adds none."""
+    from roto.olympiad.cell import run_cell
+    from roto.olympiad.results import page_label
+    from tests.rl.toy_env import ToyEnv
+
+    results = tmp_path / "results"
+    plan = load_plan(str(write_toy_plan(tmp_path, updates=2, seeds=(0,))))
+    cell, run_dir = plan.cells[0], tmp_path / "runs" / plan.cells[0].name
+    run_cell(plan, cell, run_dir, results, "aaa1111", ToyEnv)
+    plan = load_plan(str(write_toy_plan(tmp_path, updates=4, seeds=(0,))))
+    run_cell(plan, cell, run_dir, results, "bbb2222", ToyEnv)
+    summary = run_cell(plan, cell, run_dir, results, "ccc3333", ToyEnv)
+
+    starts = [{"commit": "aaa1111", "from_env_steps": 0}, {"commit": "bbb2222", "from_env_steps": 8 * 4 * 2}]
+    assert summary["trained_by"] == starts and summary["commit"] == "ccc3333"
+    assert json.loads((results / f"{cell.name}.json").read_text())["trained_by"] == starts
+    assert page_label([summary]) == "plan toy, commit aaa1111, bbb2222, ccc3333"
+
+
 def test_a_summarys_best_update_is_the_update_best_pt_holds(tmp_path):
     """Not the evaluation with the best return: Baoding chooses best.pt by round rotations."""
     root = tmp_path / "runs"
