@@ -668,13 +668,16 @@ def test_each_part_of_baoding_cpu_is_switched_off_by_exactly_one_ablation():
 
 def test_each_part_of_todays_baoding_cpu_is_switched_off_by_exactly_one_hold_ablation():
     """experiments/baoding_ablations/ablations_hold.yaml: every cell is today's baoding_cpu (the
-    hold-pose start) with one part off, the same parts as the armed recipe's ablations."""
+    hold-pose start) with one part off, on seeds 0-2 the same parts as the armed recipe's
+    ablations; a removal candidate's further cells (the Shadow's seeds 3 and 4, ORCA's seed 0 at
+    10 M) differ from the recipe's cell of their hand, seed and budget by that part alone."""
     from roto.olympiad.cell import cell_spec
 
     plan, armed = plan_named("ablations_hold"), plan_named("ablations")
     recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps)
-    assert {c.seed for c in plan.cells} == {0, 1, 2} and len(plan.cells) == len(armed.cells)
-    for cell in plan.cells:
+    first = [c for c in plan.cells if c.robot == "shadow" and c.seed in (0, 1, 2)]
+    assert len(first) == len(armed.cells)
+    for cell in first:
         part = cell.variant.removeprefix("hold_")
         same_part = cell_spec(armed, Cell("baoding", "shadow", "blind", part, cell.seed))
         expected = cell_spec(plan, cell).differences(recipe.with_seed(cell.seed))
@@ -682,6 +685,14 @@ def test_each_part_of_todays_baoding_cpu_is_switched_off_by_exactly_one_hold_abl
             blind_baoding("shadow", earlier("armed"), steps=plan.steps, seed=cell.seed)
         )
         assert cell_spec(plan, cell).differences(same_part) == {"agent.network.start_at_hold": (True, False)}
+    further = [c for c in plan.cells if c not in first]
+    assert {(c.robot, c.seed, plan.steps_for(c)) for c in further} == {
+        ("shadow", 3, 5_000_000), ("shadow", 4, 5_000_000), ("orca", 0, 10_000_000)
+    }  # fmt: skip
+    for cell in further:
+        same_seed_0 = Cell("baoding", "shadow", "blind", cell.variant, 0)
+        own = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps_for(cell), seed=cell.seed)
+        assert cell_spec(plan, cell).differences(own) == cell_spec(plan, same_seed_0).differences(recipe.with_seed(0))
 
 
 @pytest.mark.parametrize(
