@@ -160,8 +160,11 @@ def _pooled(found: dict[tuple[str, str, str], list[np.ndarray]], task: str, robo
     return np.concatenate(found[(task, robot, obs)]) if (task, robot, obs) in found else None
 
 
-def _gap(x: np.ndarray, y: np.ndarray) -> tuple[str, str]:
-    """(mean(x) − mean(y), its 95 % bootstrap interval once each side has three seeds or more)."""
+def _gap(x: np.ndarray | None, y: np.ndarray | None) -> tuple[str, str]:
+    """(mean(x) − mean(y), its 95 % bootstrap interval once each side has three seeds or more);
+    blank where a side has no seeds."""
+    if x is None or y is None:
+        return "", ""
     interval = "needs three seeds each"
     if min(x.size, y.size) >= 3:
         interval = "[{:.1f}, {:.1f}]".format(*difference_ci(x, y))
@@ -174,9 +177,11 @@ touch beats proprioception alone."""
 
 
 def orderings_table(summaries: list[dict]) -> str:
-    """Markdown: per (task, hand) with all three obs modes, their lead measure (best policies, mean
-    over seeds, variants pooled), the gaps state − blind and blind − proprio with 95 % bootstrap
-    intervals, and whether the means keep the paper's order (``ORDER``) or which pair breaks it."""
+    """Markdown: per (task, hand) with a blind agent and a state-based or proprio-only one, each obs
+    mode's lead measure (best policies, mean over seeds, variants pooled; "none" for a mode without
+    seeds), the gaps state − blind and blind − proprio with 95 % bootstrap intervals where both sides
+    have seeds, and whether the means keep the paper's order (``ORDER``), which pair breaks it, or,
+    with a mode missing, the part of the order measured so far."""
     found = lead_by_mode(summaries)
     lines = [
         "| task | hand | state (seeds) | blind (seeds) | proprio (seeds) | state − blind | 95 % CI "
@@ -185,14 +190,24 @@ def orderings_table(summaries: list[dict]) -> str:
     ]
     for task, robot in dict.fromkeys((task, robot) for task, robot, _ in found):  # lead_by_mode's order
         modes = [_pooled(found, task, robot, obs) for obs in ORDER]
-        if any(m is None for m in modes):
+        if modes[1] is None or (modes[0] is None and modes[2] is None):
             continue
-        means = [m.mean() for m in modes]
-        broken = [f"{ORDER[i]} < {ORDER[i + 1]}" for i in range(len(ORDER) - 1) if means[i] < means[i + 1]]
-        cells = [task, robot, *(f"{mean:.1f} ({m.size})" for mean, m in zip(means, modes, strict=True))]
-        cells += [*_gap(modes[0], modes[1]), *_gap(modes[1], modes[2]), "; ".join(broken) or "holds"]
+        cells = [task, robot, *(f"{m.mean():.1f} ({m.size})" if m is not None else "none" for m in modes)]
+        cells += [*_gap(modes[0], modes[1]), *_gap(modes[1], modes[2]), _order_verdict(modes)]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def _order_verdict(modes: list[np.ndarray | None]) -> str:
+    """ "holds", the pairs of ``ORDER`` whose means break it, or, with a mode missing, the measured
+    pair that holds ("blind ≥ proprio (no state)")."""
+    pairs = [(ORDER[i], ORDER[i + 1], modes[i], modes[i + 1]) for i in range(len(ORDER) - 1)]
+    measured = [(a, b, x, y) for a, b, x, y in pairs if x is not None and y is not None]
+    broken = [f"{a} < {b}" for a, b, x, y in measured if x.mean() < y.mean()]
+    if broken or len(measured) == len(pairs):
+        return "; ".join(broken) or "holds"
+    missing = ", ".join(obs for obs, m in zip(ORDER, modes, strict=True) if m is None)
+    return "; ".join(f"{a} ≥ {b}" for a, b, _, _ in measured) + f" (no {missing})"
 
 
 FIRST = (1.0, 5.0)

@@ -176,6 +176,23 @@ def test_orderings_give_both_gaps_with_intervals_and_name_the_pair_that_breaks_t
     assert both.splitlines()[2].endswith("| state < blind; blind < proprio |")
 
 
+def test_orderings_give_touchs_effect_before_the_state_based_agents_are_in():
+    """A hand with blind and proprio-only seeds but no state-based one: its row, the missing mode
+    named, touch's effect with its interval, the part of the order measured."""
+    from roto.olympiad.reference_tables import orderings_table
+
+    def mode(obs, values):
+        return [summary("bounce", "orca", obs, "ppo", s, {"bounces_mean": b}) for s, b in enumerate(values)]
+
+    (row,) = orderings_table(mode("blind", [10.0, 12.0, 14.0]) + mode("proprio", [5.0] * 3)).splitlines()[2:]
+    cells = [cell.strip() for cell in row.strip("|").split(" | ")]
+    assert cells[2:8] == ["none", "12.0 (3)", "5.0 (3)", "", "", "+7.0"] and cells[8].startswith("[")
+    assert cells[9] == "blind ≥ proprio (no state)"
+    (row,) = orderings_table(mode("state", [1.0] * 3) + mode("blind", [2.0] * 3)).splitlines()[2:]
+    assert row.endswith("| none | -1.0 | [-1.0, -1.0] |  |  | state < blind |")
+    assert len(orderings_table(mode("blind", [2.0] * 3)).splitlines()) == 2  # blind alone: no row
+
+
 def test_each_baoding_seed_gets_its_row_with_the_first_rounds_reaching_1_and_5():
     from roto.olympiad.reference_tables import seeds_table
 
