@@ -136,7 +136,7 @@ def run_cell(
     """Train (or continue) the cell, evaluate it, write and return its summary."""
     wait_until_free(run_dir)  # a retry of a cell whose first worker, declared dead, is still training it
     with Trainer.open(run_dir, cell_spec(plan, cell), env_factory=env_factory) as trainer:
-        if trainer.update < trainer.total_updates:
+        if not trainer.finished:
             record_training_start(run_dir, commit, trainer.env_steps)
         trainer.train(progress=False)
     final = copy.deepcopy(trainer.model).cpu().eval()

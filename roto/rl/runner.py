@@ -119,6 +119,11 @@ class Trainer:
         """Updates needed for the step budget (at least one)."""
         return max(1, math.ceil(self.spec.steps / self.steps_per_update))
 
+    @property
+    def finished(self) -> bool:
+        """Whether the run has made its ``total_updates`` (``train`` has nothing left to do)."""
+        return self.update >= self.total_updates
+
     # ------------------------------------------------------------------------ training
 
     def train(
@@ -144,7 +149,7 @@ class Trainer:
         )
         try:
             with StopRequests() as stop:
-                while self.update < self.total_updates:
+                while not self.finished:
                     t_start = time.perf_counter()
                     with single_torch_thread(self.device):
                         scalars = self._collect_rollout()
@@ -171,7 +176,7 @@ class Trainer:
                     bar.set_postfix(self._postfix(scalars))
                     if on_update is not None:
                         on_update(self, scalars)
-                    if stop.requested and self.update < self.total_updates:
+                    if stop.requested and not self.finished:
                         self._stop_after_update(stop.signal_name)
         finally:
             bar.close()

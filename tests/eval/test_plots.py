@@ -16,3 +16,5 @@ def test_best_evaluation_keeps_the_first_of_equals_and_reads_records_without_the
     assert best_evaluation(records((5.0, 1.0), (5.0, 1.0)), "round_rotations") == 0
     older = [{"return_mean": 1.0}, {"return_mean": 3.0}]  # evaluations from before paths were measured
     assert best_evaluation(older, "round_rotations") == 1
+    resumed = [*older, *records((2.0, 0.5))]  # a run resumed by code that measures the metric
+    assert best_evaluation(resumed, "round_rotations") == 2
