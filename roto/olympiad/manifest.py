@@ -35,8 +35,12 @@ def manifest_rows(summaries: list[dict], plan: Plan | None = None) -> list[dict[
     for s in summaries:
         cell = f"{s['task']}-{s['robot']}-{s['obs']}-{s['variant']}-seed{s['seed']}"
         row = {key: str(s.get(key, "not recorded")) for key in COLUMNS}
-        row.update(cell=cell, config=config_label(s, plan), training_aids=training_aids(s, plan))
-        row.update(trained_by=trained_by_label(s))
+        row.update(
+            cell=cell,
+            config=config_label(s, plan),
+            training_aids=training_aids(s, plan),
+            trained_by=trained_by_label(s),
+        )
         rows.append(row)
     return sorted(rows, key=lambda row: row["cell"])
 
