@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import pathlib
 import textwrap
 from collections.abc import Mapping, Sequence
@@ -22,15 +21,9 @@ def curve_metrics(records: Sequence[Mapping]) -> list[str]:
 def best_evaluation(records: Sequence[Mapping], selection_metric: str | None = None) -> int:
     """The index of the evaluation ``best.pt`` holds: ranked as training ranks them (``best_eval_key``:
     the task's ``selection_metric``, Baoding's round rotations, then the return; the return alone
-    for a task without one), the first of equals. A record from before the metric was measured
-    ranks below every record that has it, as its checkpoint does in training (``load_best_eval``)."""
-
-    def key(record: Mapping) -> tuple[float, float]:
-        if selection_metric and f"{selection_metric}_mean" not in record:
-            return (-math.inf, float(record["return_mean"]))
-        return best_eval_key(dict(record), selection_metric)
-
-    keys = [key(r) for r in records]
+    for a task without one; a record from before the metric was measured below every record with
+    it), the first of equals."""
+    keys = [best_eval_key(dict(r), selection_metric) for r in records]
     return max(range(len(keys)), key=lambda i: (keys[i], -i))
 
 

@@ -38,9 +38,11 @@ def best_eval_key(record: dict[str, Any], selection_metric: str | None) -> tuple
     """How an evaluation ranks for ``best.pt``: (the mean of the task's ``selection_metric``, the
     mean return), compared in that order; the return alone (twice) for a task without one. Baoding
     selects by round rotations, so a policy that swings the balls out and back (paid by the return
-    as a rotation would be) never displaces one that carries them round."""
+    as a rotation would be) never displaces one that carries them round. A record from before the
+    metric was measured ranks below every record that has it (-inf), as its checkpoint does
+    (``load_best_eval``)."""
     ret = float(record["return_mean"])
-    return (float(record[f"{selection_metric}_mean"]) if selection_metric else ret, ret)
+    return (float(record.get(f"{selection_metric}_mean", -math.inf)) if selection_metric else ret, ret)
 
 
 def load_best_eval(state: dict[str, Any], selection_metric: str | None) -> tuple[float, float]:

@@ -23,6 +23,8 @@ def test_best_pt_goes_by_the_tasks_selection_metric_then_the_return():
     round_ = {"return_mean": 500.0, "round_rotations_mean": 6.0}
     assert best_eval_key(round_, "round_rotations") > best_eval_key(swing, "round_rotations")
     assert best_eval_key(round_, None) < best_eval_key(swing, None)  # Bounce: the return alone
+    older = {"return_mean": 950.0}  # an evaluation from before round rotations were measured
+    assert best_eval_key(older, "round_rotations") < best_eval_key(swing, "round_rotations")
     assert load_best_eval({"best_eval_return": 7.0}, None) == (7.0, 7.0)
     assert load_best_eval({"best_eval_return": 7.0}, "round_rotations") == (float("-inf"), 7.0)
     assert load_best_eval({"best_eval": [6.0, 500.0], "best_eval_return": 500.0}, "round_rotations") == (6.0, 500.0)
