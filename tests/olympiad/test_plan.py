@@ -822,3 +822,18 @@ def test_the_hold_noise_probe_bounds_the_allegros_std_at_the_noise_its_hold_tole
     lower = {"agent.network.init_log_std": (log_std, -1.386), "agent.network.max_log_std": (log_std, -1.386)}
     plan = assert_baoding_cpu_cells_but("hold_noise", [("allegro", 1), ("allegro", 3)], lower)
     assert plan.steps == 10_000_000
+
+
+def test_the_lean_recipe_is_baoding_cpu_with_its_two_bank_aids_off_on_every_hand():
+    """experiments/baoding_lean/lean.yaml: each cell is the recipe's cell of its hand, seed and
+    budget with the replayed starts and the round swaps switched off, nothing else."""
+    from roto.olympiad.cell import cell_spec
+
+    plan = plan_named("lean")
+    assert {(c.robot, c.seed, plan.steps_for(c)) for c in plan.cells} == {
+        *(("shadow", seed, 5_000_000) for seed in range(5)), ("orca", 0, 10_000_000), ("allegro", 0, 10_000_000)
+    }  # fmt: skip
+    for cell in plan.cells:
+        own = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps_for(cell), seed=cell.seed)
+        off = {key: mine for key, (mine, _) in cell_spec(plan, cell).differences(own).items()}
+        assert off == {"env.aids.replayed_starts": None, "env.aids.round_swaps": None}
