@@ -691,10 +691,16 @@ def test_each_part_of_todays_baoding_cpu_is_switched_off_by_exactly_one_hold_abl
     }  # fmt: skip
     for cell in further:  # the part is off as on seed 0; the recipe's side is the hand's own (its bank)
         same_seed_0 = Cell("baoding", "shadow", "blind", cell.variant, 0)
-        own = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps_for(cell), seed=cell.seed)
-        mine = cell_spec(plan, cell).differences(own)
-        on_seed_0 = cell_spec(plan, same_seed_0).differences(recipe.with_seed(0))
-        assert {key: off for key, (off, _) in mine.items()} == {key: off for key, (off, _) in on_seed_0.items()}
+        assert switched_off(plan, cell) == switched_off(plan, same_seed_0)
+
+
+def switched_off(plan, cell: Cell) -> dict:
+    """What a plan's blind Baoding cell sets where it differs from ``baoding_cpu``'s cell of its hand,
+    seed and budget, the recipe's side left out (each hand's recipe names its own bank)."""
+    from roto.olympiad.cell import cell_spec
+
+    own = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps_for(cell), seed=cell.seed)
+    return {key: mine for key, (mine, _) in cell_spec(plan, cell).differences(own).items()}
 
 
 @pytest.mark.parametrize(
@@ -827,13 +833,9 @@ def test_the_hold_noise_probe_bounds_the_allegros_std_at_the_noise_its_hold_tole
 def test_the_lean_recipe_is_baoding_cpu_with_its_two_bank_aids_off_on_every_hand():
     """experiments/baoding_lean/lean.yaml: each cell is the recipe's cell of its hand, seed and
     budget with the replayed starts and the round swaps switched off, nothing else."""
-    from roto.olympiad.cell import cell_spec
-
     plan = plan_named("lean")
     assert {(c.robot, c.seed, plan.steps_for(c)) for c in plan.cells} == {
         *(("shadow", seed, 5_000_000) for seed in range(5)), ("orca", 0, 10_000_000), ("allegro", 0, 10_000_000)
     }  # fmt: skip
     for cell in plan.cells:
-        own = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps_for(cell), seed=cell.seed)
-        off = {key: mine for key, (mine, _) in cell_spec(plan, cell).differences(own).items()}
-        assert off == {"env.aids.replayed_starts": None, "env.aids.round_swaps": None}
+        assert switched_off(plan, cell) == {"env.aids.replayed_starts": None, "env.aids.round_swaps": None}
