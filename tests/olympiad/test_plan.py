@@ -552,14 +552,21 @@ def test_baoding_cpu_is_the_armed_recipe_started_at_the_hold_pose_as_the_studies
 def assert_baoding_cpu_cells_but(name: str, cells: list[tuple[str, int]], differences: dict):
     """Plan ``name`` holds exactly ``cells`` ((robot, seed), in order), each the blind Baoding cell of
     ``baoding_cpu`` on that hand and seed at the plan's budget but for ``differences``; the plan."""
-    from roto.olympiad.cell import cell_spec
-
     plan = plan_named(name)
     assert [(c.robot, c.seed) for c in plan.cells] == cells
     for cell in plan.cells:
-        recipe = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps, seed=cell.seed)
-        assert cell_spec(plan, cell).differences(recipe) == differences
+        assert plan.steps_for(cell) == plan.steps
+        assert against_the_recipe(plan, cell) == differences
     return plan
+
+
+def against_the_recipe(plan, cell: Cell) -> dict:
+    """Where a plan's blind Baoding cell differs from ``baoding_cpu``'s cell of its hand, seed and
+    budget: {key: (the cell's value, the recipe's)}."""
+    from roto.olympiad.cell import cell_spec
+
+    own = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps_for(cell), seed=cell.seed)
+    return cell_spec(plan, cell).differences(own)
 
 
 def test_the_hold_start_study_is_baoding_cpu():
@@ -697,10 +704,7 @@ def test_each_part_of_todays_baoding_cpu_is_switched_off_by_exactly_one_hold_abl
 def switched_off(plan, cell: Cell) -> dict:
     """What a plan's blind Baoding cell sets where it differs from ``baoding_cpu``'s cell of its hand,
     seed and budget, the recipe's side left out (each hand's recipe names its own bank)."""
-    from roto.olympiad.cell import cell_spec
-
-    own = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps_for(cell), seed=cell.seed)
-    return {key: mine for key, (mine, _) in cell_spec(plan, cell).differences(own).items()}
+    return {key: mine for key, (mine, _) in against_the_recipe(plan, cell).items()}
 
 
 @pytest.mark.parametrize(
