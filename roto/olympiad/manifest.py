@@ -30,7 +30,8 @@ COLUMNS = (
 
 def manifest_rows(summaries: list[dict], plan: Plan | None = None) -> list[dict[str, str]]:
     """One row per summary (``COLUMNS``), cells in name order; a field a summary did not record
-    (an older summary's task version) is "not recorded"."""
+    (an older summary's task version) is "not recorded"; a version established after training
+    names how (``task_version_check``)."""
     rows = []
     for s in summaries:
         cell = f"{s['task']}-{s['robot']}-{s['obs']}-{s['variant']}-seed{s['seed']}"
@@ -41,6 +42,8 @@ def manifest_rows(summaries: list[dict], plan: Plan | None = None) -> list[dict[
             training_aids=training_aids(s, plan),
             trained_by=trained_by_label(s),
         )
+        if "task_version_check" in s:
+            row["task_version"] += f" ({s['task_version_check']})"
         rows.append(row)
     return sorted(rows, key=lambda row: row["cell"])
 

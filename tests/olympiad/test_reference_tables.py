@@ -140,6 +140,8 @@ def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_p
     resumed = summary("bounce", "orca", "blind", "ppo", 0, {"bounces_mean": 1.0})
     resumed["trained_by"] = [{"commit": "aaa1111", "from_env_steps": 0}, {"commit": "abc1234", "from_env_steps": 64}]
     assert manifest_rows([resumed])[0]["trained_by"] == "aaa1111 from 0; abc1234 from 64"
+    checked = {**resumed, "task_version": 0, "task_version_check": "rollouts at aaa1111 bit-identical"}
+    assert manifest_rows([checked])[0]["task_version"] == "0 (rollouts at aaa1111 bit-identical)"
     write_folder(tmp_path / "cells", SUMMARIES)
     assert main(["results", str(tmp_path / "cells"), "--out", str(tmp_path / "out")]) == 0
     written = list(csv.DictReader((tmp_path / "out" / "manifest.csv").open()))
