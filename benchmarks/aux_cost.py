@@ -18,7 +18,7 @@ import tempfile
 import torch
 
 from roto.envs.config import EnvConfig
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 from roto.rl.run_dir import read_scalars
 from roto.rl.run_spec import RunSpec
 from roto.rl.runner import Trainer

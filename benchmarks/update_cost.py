@@ -30,7 +30,7 @@ import torch
 from roto.envs.config import EnvConfig
 from roto.envs.roto_env import RotoEnv
 from roto.rl.build import build_learner, build_model, extra_groups, stacked_sizes
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 from roto.rl.ppo import PPO
 
 

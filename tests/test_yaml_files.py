@@ -5,7 +5,7 @@ import pytest
 from roto.cli import main
 from roto.envs.config import EnvConfig
 from roto.olympiad.plan import load_plan
-from roto.rl.config import load_agent_config, parse_override
+from roto.rl.config_files import load_agent_config, parse_override
 from roto.rl.run_config import read_run_config
 from roto.sweep.space import load_space
 from roto.yaml_files import read_yaml

@@ -14,7 +14,7 @@ from typing import Any
 
 from roto.envs.aids.settings import LEGACY_FIELDS
 from roto.envs.config import EnvConfig
-from roto.rl.config import merge, parse_override
+from roto.rl.config_files import merge, parse_override
 
 AIDS = "aids"
 

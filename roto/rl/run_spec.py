@@ -18,7 +18,8 @@ from typing import Any
 from roto.envs.aids.settings import aids_from_legacy_fields
 from roto.envs.config import EnvConfig
 from roto.envs.replay_starts import check_replay_starts
-from roto.rl.config import AgentConfig, from_dict, load_agent_config, load_training_aids, to_dict
+from roto.rl.config import AgentConfig, from_dict, to_dict
+from roto.rl.config_files import load_agent_config, load_training_aids
 from roto.rl.overrides import apply_env_overrides, split_overrides
 from roto.robots import get_robot
 from roto.tasks import get_task

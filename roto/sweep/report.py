@@ -11,7 +11,8 @@ from optuna.trial import TrialState
 
 from roto.jobs.storage import REASON_ATTR, RETRY_OF_ATTR
 from roto.result_files import write_text_atomic
-from roto.rl.config import load_agent_config, packaged_configs, to_dict
+from roto.rl.config import to_dict
+from roto.rl.config_files import load_agent_config, packaged_configs
 from roto.rl.overrides import split_overrides
 from roto.sweep.space import as_overrides
 from roto.sweep.study import SETTINGS_ATTR, TIE_BREAK, load_existing_study

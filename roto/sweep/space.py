@@ -26,7 +26,8 @@ from typing import Any
 import optuna
 
 from roto.envs.config import EnvConfig
-from roto.rl.config import AgentConfig, from_dict, load_agent_config
+from roto.rl.config import AgentConfig, from_dict
+from roto.rl.config_files import load_agent_config
 from roto.rl.overrides import apply_env_overrides, split_overrides
 from roto.rl.run_spec import training_env
 from roto.rl.ssl.configs import SSLConfig

@@ -69,7 +69,7 @@ def enqueue_base(study: optuna.Study, settings: SweepSettings, space: Any) -> tu
     trial: each searched parameter at the base's value where its distribution can draw it, drawn
     as usual where not. Only into a study without trials (ValueError otherwise); returns
     (the enqueued values, the base values outside the space)."""
-    from roto.rl.config import load_agent_config
+    from roto.rl.config_files import load_agent_config
     from roto.rl.overrides import split_overrides
     from roto.rl.run_spec import training_env
     from roto.sweep.space import base_values

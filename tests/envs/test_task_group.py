@@ -7,7 +7,7 @@ import roto
 from roto.envs.observations import OBS_MODES
 from roto.envs.single_world import supports_single_world_step
 from roto.rl.build import build_model, extra_groups, resolve_groups, stacked_sizes
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 
 TASK_CRITIC = ["network.critic=[tactile, proprio, privileged, task]", "network.encoder=[16]"]
 

@@ -7,7 +7,7 @@ import pytest
 
 from roto.envs.replay_starts import packaged_banks
 from roto.olympiad.plan import Cell, load_plan, packaged_plans, select_cells
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 from roto.robots import ROBOTS
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

@@ -1,7 +1,7 @@
 """Training-time evaluation records the task's path metrics beside its metrics."""
 
 from roto.envs.config import EnvConfig
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 from roto.rl.run_spec import RunSpec
 from roto.rl.runner import Trainer
 

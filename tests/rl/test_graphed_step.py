@@ -8,7 +8,7 @@ import pytest
 import torch
 
 from roto.rl.build import build_learner, build_model
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 from roto.rl.graphed_call import clone_tree, copy_tree
 
 SIZES = {"proprio": 12, "tactile": 4}

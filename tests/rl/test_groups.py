@@ -6,7 +6,7 @@ import torch
 import roto
 from roto.envs.observations import OBS_MODES
 from roto.rl.build import build_model, extra_groups, resolve_groups, stacked_sizes
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 
 ROBOTS = ["shadow", "shadow_lite", "allegro", "orca"]
 PRIVILEGED_CRITIC = ["network.critic=[tactile, proprio, privileged]", "network.encoder=[16]"]

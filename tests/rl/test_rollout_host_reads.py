@@ -9,7 +9,7 @@ import torch
 from roto.envs.aids.event_recorder import RecordedEvents
 from roto.envs.aids.tolerance import ToleranceAid
 from roto.envs.config import EnvConfig
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 from roto.rl.run_spec import RunSpec
 from roto.rl.runner import Trainer
 from tests.conftest import BAODING_AIDS, require_warp

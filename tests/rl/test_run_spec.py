@@ -2,7 +2,7 @@ import pathlib
 
 import pytest
 
-from roto.rl.config import packaged_configs
+from roto.rl.config_files import packaged_configs
 from roto.rl.run_spec import build_run_spec
 from roto.rl.runner import Trainer
 from roto.robots import ROBOTS

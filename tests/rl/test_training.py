@@ -2,7 +2,7 @@ import pytest
 import torch
 
 from roto.envs.config import EnvConfig
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 from roto.rl.run_spec import RunSpec
 from roto.rl.runner import Trainer
 from tests.rl.toy_env import ToyEnv

@@ -11,7 +11,7 @@ import yaml
 from optuna.trial import TrialState
 
 from roto.jobs.storage import REASON_ATTR, open_storage
-from roto.rl.config import load_agent_config
+from roto.rl.config_files import load_agent_config
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import CHECKPOINT_DIR
 from roto.sweep.report import export_best, show
