@@ -64,11 +64,10 @@ def rollout_keys(robot: str, obs_mode: str) -> dict[str, list]:
 
 def run_at(checkout: str, pairs: list[str]) -> dict:
     """The digests of ``pairs`` with the roto of ``checkout`` first on the path."""
-    env = {**os.environ, "PYTHONPATH": checkout}
     code = "import json,sys,roto; from rollout_digest import rollout_keys as r; "
     code += "print(roto.__file__); print(json.dumps({p: r(*p.split(':')) for p in sys.argv[1:]}))"
     here = os.path.dirname(os.path.abspath(__file__))
-    env["PYTHONPATH"] = f"{checkout}{os.pathsep}{here}"
+    env = {**os.environ, "PYTHONPATH": f"{checkout}{os.pathsep}{here}"}
     lines = subprocess.run(
         [sys.executable, "-c", code, *pairs], env=env, cwd=here, capture_output=True, text=True, check=True
     ).stdout.splitlines()

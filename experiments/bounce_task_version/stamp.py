@@ -3,24 +3,20 @@ rollout_digest.py found the task at their training commits bit-identical to toda
 
     python experiments/bounce_task_version/stamp.py CHECKED_AT SUMMARY.json ...
 
-Each summary gains ``task_version`` (Bounce's version at ``CHECKED_AT``) and ``task_version_check``
+Run at ``CHECKED_AT``, the commit the rollouts were compared against: each summary gains
+``task_version`` (this checkout's Bounce version) and ``task_version_check``
 saying how it was established; a summary that already records a version is refused.
 """
 
 import json
 import pathlib
-import subprocess
 import sys
+
+from roto.tasks import get_task
 
 
 def main(checked_at: str, paths: list[str]) -> None:
-    version = int(
-        subprocess.run(
-            ["git", "show", f"{checked_at}:roto/tasks/bounce.py"], capture_output=True, text=True, check=True
-        )
-        .stdout.split("    version = ")[1]
-        .split()[0]
-    )
+    version = get_task("bounce").version  # this checkout's: run it at the commit compared against
     for path in map(pathlib.Path, paths):
         summary = json.loads(path.read_text())
         if summary["task"] != "bounce" or "task_version" in summary:
