@@ -530,28 +530,33 @@ def blind_baoding(robot: str, config: str, overrides: list[str] = (), steps: int
 ROUND_BANK = earlier("round_bank")
 """baoding_cpu as the round-bank and round-swaps studies trained it, before it took armed round swaps."""
 ARMED = ["env.aids.round_swaps={min_turn: 0.25, first_paid: true, after: 2}"]
+HOLD = earlier("hold")
+"""baoding_cpu as the hold-start study and the studies after it trained it (today's baoding_cpu)."""
 
 
 def test_baoding_cpu_is_the_armed_recipe_started_at_the_hold_pose_as_the_studies_trained_them():
     """The packaged one-for-every-hand recipe is, on each hand, the frozen round-bank recipe plus
     round swaps armed after 2 rotations (what experiments/baoding_armed_round_swaps trained as
-    armed_round, frozen as baoding_cpu_armed) with the policy started at the hold pose: what
-    experiments/baoding_hold_start trained, so that study's results are baoding_cpu's."""
+    armed_round, frozen as baoding_cpu_armed) with the policy started at the hold pose (frozen as
+    baoding_cpu_hold): what experiments/baoding_hold_start trained, so that study's results are
+    baoding_cpu's."""
     from roto.olympiad.cell import cell_spec
 
     for robot in ROBOTS:
         armed = blind_baoding(robot, earlier("armed"))
         assert armed.differences(blind_baoding(robot, ROUND_BANK, ARMED)) == {}
-        assert blind_baoding(robot, "baoding_cpu").differences(armed) == {"agent.network.start_at_hold": (True, False)}
+        hold = blind_baoding(robot, HOLD)
+        assert hold.differences(armed) == {"agent.network.start_at_hold": (True, False)}
+        assert blind_baoding(robot, "baoding_cpu").differences(hold) == {}
     for name in ("armed", "armed_untuned"):
         study = plan_named(name)
         for cell in study.cells:
             assert cell_spec(study, cell).differences(blind_baoding(cell.robot, earlier("armed"), seed=cell.seed)) == {}
 
 
-def assert_baoding_cpu_cells_but(name: str, cells: list[tuple[str, int]], differences: dict):
+def assert_hold_recipe_cells_but(name: str, cells: list[tuple[str, int]], differences: dict):
     """Plan ``name`` holds exactly ``cells`` ((robot, seed), in order), each the blind Baoding cell of
-    ``baoding_cpu`` on that hand and seed at the plan's budget but for ``differences``; the plan."""
+    ``baoding_cpu_hold`` on that hand and seed at the plan's budget but for ``differences``; the plan."""
     plan = plan_named(name)
     assert [(c.robot, c.seed) for c in plan.cells] == cells
     for cell in plan.cells:
@@ -561,28 +566,29 @@ def assert_baoding_cpu_cells_but(name: str, cells: list[tuple[str, int]], differ
 
 
 def against_the_recipe(plan, cell: Cell) -> dict:
-    """Where a plan's blind Baoding cell differs from ``baoding_cpu``'s cell of its hand, seed and
-    budget: {key: (the cell's value, the recipe's)}."""
+    """Where a plan's blind Baoding cell differs from ``baoding_cpu_hold``'s cell of its hand, seed
+    and budget: {key: (the cell's value, the recipe's)}."""
     from roto.olympiad.cell import cell_spec
 
-    own = blind_baoding(cell.robot, "baoding_cpu", steps=plan.steps_for(cell), seed=cell.seed)
+    own = blind_baoding(cell.robot, HOLD, steps=plan.steps_for(cell), seed=cell.seed)
     return cell_spec(plan, cell).differences(own)
 
 
-def test_the_hold_start_study_is_baoding_cpu():
-    """experiments/baoding_hold_start trained today's baoding_cpu, seeds 0-9 of the blind Shadow."""
-    assert_baoding_cpu_cells_but("hold_start", [("shadow", s) for s in range(10)], {})
+def test_the_hold_start_study_is_the_frozen_hold_recipe():
+    """experiments/baoding_hold_start trained baoding_cpu_hold (today's baoding_cpu), seeds 0-9 of the
+    blind Shadow."""
+    assert_hold_recipe_cells_but("hold_start", [("shadow", s) for s in range(10)], {})
 
 
 def test_the_kl_target_study_is_baoding_cpu_with_only_its_kl_target_doubled():
     """experiments/baoding_kl_target pairs each seed with baoding_hold_start's run of baoding_cpu."""
     doubled = {"agent.ppo.kl_target": (0.016, 0.008)}
-    assert_baoding_cpu_cells_but("kl_target", [("shadow", s) for s in range(5)], doubled)
+    assert_hold_recipe_cells_but("kl_target", [("shadow", s) for s in range(5)], doubled)
 
 
 def test_the_turn_near_probe_is_the_allegros_baoding_cpu_cell_with_only_its_turn_shaping_gated():
     """experiments/baoding_turn_near probes the Allegro's seed 1, which baoding_cpu left turning off the targets."""
-    plan = assert_baoding_cpu_cells_but("turn_near", [("allegro", 1)], {"env.aids.turn_shaping.near": (1.5, None)})
+    plan = assert_hold_recipe_cells_but("turn_near", [("allegro", 1)], {"env.aids.turn_shaping.near": (1.5, None)})
     assert [c.name for c in plan.cells] == ["baoding-allegro-blind-near_1_5-seed1"] and plan.steps == 10_000_000
 
 
@@ -681,7 +687,7 @@ def test_each_part_of_todays_baoding_cpu_is_switched_off_by_exactly_one_hold_abl
     from roto.olympiad.cell import cell_spec
 
     plan, armed = plan_named("ablations_hold"), plan_named("ablations")
-    recipe = blind_baoding("shadow", "baoding_cpu", steps=plan.steps)
+    recipe = blind_baoding("shadow", HOLD, steps=plan.steps)
     first = [c for c in plan.cells if c.robot == "shadow" and c.seed in (0, 1, 2)]
     assert len(first) == len(armed.cells)
     for cell in first:
@@ -702,8 +708,8 @@ def test_each_part_of_todays_baoding_cpu_is_switched_off_by_exactly_one_hold_abl
 
 
 def switched_off(plan, cell: Cell) -> dict:
-    """What a plan's blind Baoding cell sets where it differs from ``baoding_cpu``'s cell of its hand,
-    seed and budget, the recipe's side left out (each hand's recipe names its own bank)."""
+    """What a plan's blind Baoding cell sets where it differs from ``baoding_cpu_hold``'s cell of its
+    hand, seed and budget, the recipe's side left out (each hand's recipe names its own bank)."""
     return {key: mine for key, (mine, _) in against_the_recipe(plan, cell).items()}
 
 
@@ -735,20 +741,20 @@ def test_the_first_paid_plans_are_baoding_cpu_with_round_swaps_paying_the_first_
 def test_the_turn_pay_study_is_baoding_cpu_with_only_its_turn_shaping_doubled():
     """experiments/baoding_turn_pay pairs each seed with baoding_hold_start's run of baoding_cpu."""
     doubled = {"env.aids.turn_shaping.per_turn": (40.0, 20.0)}
-    assert_baoding_cpu_cells_but("turn_pay", [("shadow", s) for s in range(5)], doubled)
+    assert_hold_recipe_cells_but("turn_pay", [("shadow", s) for s in range(5)], doubled)
 
 
 def test_the_turn_soft_probe_is_the_allegros_baoding_cpu_cells_with_only_its_turn_shaping_falling_off():
     """experiments/baoding_turn_soft probes the Allegro's seeds 1 and 3, which baoding_cpu left off the targets."""
     falling = {"env.aids.turn_shaping.near": (1.0, None), "env.aids.turn_shaping.soft": (True, False)}
-    plan = assert_baoding_cpu_cells_but("turn_soft", [("allegro", 1), ("allegro", 3)], falling)
+    plan = assert_hold_recipe_cells_but("turn_soft", [("allegro", 1), ("allegro", 3)], falling)
     assert plan.steps == 10_000_000
 
 
 def test_the_wide_latch_probe_is_the_allegros_baoding_cpu_cells_with_only_its_latch_starting_at_5_cm():
     """experiments/baoding_wide_latch probes the Allegro's seeds 1 and 3, which baoding_cpu left off the targets."""
     wide = {"env.aids.tolerance.start": (0.05, 0.025)}
-    plan = assert_baoding_cpu_cells_but("wide_latch", [("allegro", 1), ("allegro", 3)], wide)
+    plan = assert_hold_recipe_cells_but("wide_latch", [("allegro", 1), ("allegro", 3)], wide)
     assert plan.steps == 10_000_000
 
 
@@ -758,19 +764,19 @@ def test_the_forward_dynamics_study_is_baoding_cpu_with_only_roto_s_memory_loss_
 
     loss = ForwardDynamicsMemoryConfig(weight=0.025, lr=2.5e-4, seq_length=2)
     added = {"agent.ssl.forward_dynamics_memory": (json.loads(json.dumps(dataclasses.asdict(loss))), None)}
-    assert_baoding_cpu_cells_but("forward_dynamics", [("shadow", s) for s in range(5)], added)
+    assert_hold_recipe_cells_but("forward_dynamics", [("shadow", s) for s in range(5)], added)
 
 
 def test_the_std_free_study_is_baoding_cpu_with_its_std_projected_and_no_entropy_bonus():
     """experiments/baoding_std_free pairs each seed with baoding_hold_start's run of baoding_cpu."""
     free = {"agent.network.project_log_std": (True, False), "agent.ppo.entropy_coef": (0.0, 0.05)}
-    assert_baoding_cpu_cells_but("std_free", [("shadow", s) for s in range(5)], free)
+    assert_hold_recipe_cells_but("std_free", [("shadow", s) for s in range(5)], free)
 
 
 def test_the_low_noise_study_is_baoding_cpu_with_its_std_bounded_at_0_15():
     """experiments/baoding_low_noise pairs each seed with baoding_hold_start's run of baoding_cpu."""
     lower = {"agent.network.init_log_std": (-1.897, -1.386), "agent.network.max_log_std": (-1.897, -1.386)}
-    assert_baoding_cpu_cells_but("low_noise", [("shadow", s) for s in range(5)], lower)
+    assert_hold_recipe_cells_but("low_noise", [("shadow", s) for s in range(5)], lower)
 
 
 def test_the_turn_soft_continuation_is_its_probes_cell_at_20_m():
@@ -785,7 +791,7 @@ def test_the_turn_focus_probe_is_the_allegros_baoding_cpu_cells_with_a_narrowing
         "env.aids.turn_shaping.soft": (True, False),
         "env.aids.turn_shaping.near_from": (3.0, None),
     }
-    plan = assert_baoding_cpu_cells_but("turn_focus", [("allegro", 1), ("allegro", 3)], focus)
+    plan = assert_hold_recipe_cells_but("turn_focus", [("allegro", 1), ("allegro", 3)], focus)
     assert plan.steps == 20_000_000
 
 
@@ -797,14 +803,14 @@ def test_the_turn_latch_probe_is_turn_focus_with_the_latch_narrowing_by_net_turn
         "env.aids.turn_shaping.near_from": (3.0, None),
         "env.aids.tolerance.by": ("net_turns", "headline"),
     }
-    plan = assert_baoding_cpu_cells_but("turn_latch", [("allegro", 1), ("allegro", 3)], focus)
+    plan = assert_hold_recipe_cells_but("turn_latch", [("allegro", 1), ("allegro", 3)], focus)
     assert plan.steps == 20_000_000
 
 
 def test_the_latch_deadline_probe_is_the_allegros_baoding_cpu_with_only_a_deadline():
     """experiments/baoding_latch_deadline: the Allegro's cells with the latch at 1 cm from 5 M on."""
     deadline = {"env.aids.tolerance.deadline": (5_000_000, None)}
-    plan = assert_baoding_cpu_cells_but("latch_deadline", [("allegro", 0), ("allegro", 4)], deadline)
+    plan = assert_hold_recipe_cells_but("latch_deadline", [("allegro", 0), ("allegro", 4)], deadline)
     assert plan.steps == 10_000_000
 
 
@@ -830,7 +836,7 @@ def test_the_hold_noise_probe_bounds_the_allegros_std_at_the_noise_its_hold_tole
     assert noise == 0.15
     log_std = round(math.log(noise), 3)  # the plan's value, derived from the hand's tolerated noise
     lower = {"agent.network.init_log_std": (log_std, -1.386), "agent.network.max_log_std": (log_std, -1.386)}
-    plan = assert_baoding_cpu_cells_but("hold_noise", [("allegro", 1), ("allegro", 3)], lower)
+    plan = assert_hold_recipe_cells_but("hold_noise", [("allegro", 1), ("allegro", 3)], lower)
     assert plan.steps == 10_000_000
 
 
