@@ -4,7 +4,7 @@ The run directory is ``<root>/<plan>/<cell>`` (an ordinary run: ``roto eval``, `
 ``roto train --resume`` work on it); a cell whose run has a checkpoint continues from it. The
 summary, ``<results>/<cell>.json``, is small enough to commit: the evaluation curve, the training
 scalars between evaluations (the policy's action std, the training episodes' return, length and
-task metrics), the training aids its run used, the final and best policies' evaluations over the
+task metrics), the training aids its run used and its whole run spec, the final and best policies' evaluations over the
 plan's episodes (per-episode returns and task metrics included), the training wall time, the
 commit that wrote it and the commits that trained it: each start of training appends its commit
 and the env steps it started from to ``<run_dir>/commits.jsonl`` (``TRAINED_BY``), so a cell
@@ -151,6 +151,7 @@ def run_cell(
         "plan": plan.name,
         "agent": agent_record(plan, cell),
         "training_aids": trainer.spec.env.aids.to_dict(),
+        "spec": trainer.spec.to_dict(),  # what the plan check compares (roto.olympiad.staleness)
         "commit": commit,
         "trained_by": trained_by(run_dir),
         "run_dir": str(run_dir),

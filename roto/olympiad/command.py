@@ -87,6 +87,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     from roto.jobs.claims import launch_workers
     from roto.jobs.storage import reclaim_now, resolve_storage, storage_in_environment
     from roto.olympiad.plan import load_plan, select_cells
+    from roto.olympiad.staleness import refuse_stale
     from roto.olympiad.worker import enqueue_missing, open_olympiad, run_olympiad_worker
 
     args.storage = resolve_storage(args.storage)
@@ -104,14 +105,13 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         adopted = adopt_cells(source_plan, source_results, plan, results)
         print(json.dumps({"plan": plan.name, "adopted": adopted, "from": source_plan.name, "results": str(results)}))
         return 0
-    if args.dry_run:
-        if args.workers < 1:
-            raise ValueError(f"--workers must be >= 1, got {args.workers}")
-        print(dry_run_report(chosen, args.root, results, args.storage, args.workers, plan if args.only else None))
-        return 0
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    if args.dry_run:
+        print(dry_run_report(chosen, args.root, results, args.storage, args.workers, plan if args.only else None))
+        return 0
     if args.workers > 1:
+        refuse_stale(chosen, results, args.root)  # before the study is made: nothing changed
         # create the study and enqueue the cells once, so the workers only join and claim
         study, storage = open_olympiad(plan, args.root, args.storage)
         if args.reclaim_now:  # here, once: a worker reclaiming would take its siblings' fresh claims
@@ -165,6 +165,11 @@ def status_metrics(task: Task, records: list[dict]) -> tuple[str, tuple[str, ...
     return lead, tuple(m for m in (task.headline_metric, *task.path_metric_names) if m != lead)
 
 
+FINISHED = ("done", "stale")
+"""The statuses of a cell with a summary: a worker trains neither (it refuses to start beside a
+stale one, ``roto.olympiad.staleness.refuse_stale``)."""
+
+
 def dry_run_report(
     plan: Plan, root: str, results: pathlib.Path, storage: str | None, workers: int = 1, whole: Plan | None = None
 ) -> str:
@@ -172,12 +177,14 @@ def dry_run_report(
     the env steps of its run's last evaluation; ``time_left_estimate``). ``whole``: the plan
     ``--only`` chose ``plan``'s cells from, whose finished cells give the throughput."""
     from roto.jobs.storage import journal_of
+    from roto.olympiad.staleness import describe, stale_cells
     from roto.olympiad.time_left import recent_rate
     from roto.olympiad.worker import cell_status
     from roto.rl.evaluation import read_evaluations
     from roto.tasks import get_task
 
     status = cell_status(plan, root, results, storage)
+    stale = stale_cells(plan, results) if "stale" in status.values() else {}
     tasks = {cell.name: get_task(cell.task) for cell in plan.cells}
     budgets = {cell.name: plan.steps_for(cell) for cell in plan.cells}
     uniform = len(set(budgets.values())) == 1
@@ -186,7 +193,7 @@ def dry_run_report(
     lines = [f"plan {plan.name}: {len(plan.cells)} cells{chosen}, {each}", ""]
     done_steps, started_rates = {}, []
     for name, state in status.items():
-        records = [] if state == "done" else read_evaluations(pathlib.Path(root) / plan.name / name)
+        records = [] if state in FINISHED else read_evaluations(pathlib.Path(root) / plan.name / name)
         done_steps[name] = min(int(records[-1]["env_steps"]), budgets[name]) if records else 0
         if rate_now := recent_rate(records):
             started_rates.append(rate_now)
@@ -194,12 +201,17 @@ def dry_run_report(
         progress = f" ({done_steps[name] / 1e6:.1f} M env steps{so_far})" if records else ""
         budget = "" if uniform else f" [{budgets[name] / 1e6:g} M]"
         lines.append(f"  {name:<52} {state}{budget}{progress}")
-    left = sum(state != "done" for state in status.values())
+        if name in stale:  # summary's -> plan's
+            lines.append(f"    trained otherwise: {describe(stale[name])}")
+    left = sum(state not in FINISHED for state in status.values())
     journal = journal_of(pathlib.Path(root) / plan.name, storage)
     if left and journal is not None and not journal.is_file():
         lines += ["", f"no workers' journal at {journal}: a cell running under another --root shows as not started"]
-    steps_left = {name: budgets[name] - done_steps[name] for name, state in status.items() if state != "done"}
-    lines += ["", f"{len(status) - left} done, {left} left; time left: "]
+    steps_left = {name: budgets[name] - done_steps[name] for name, state in status.items() if state not in FINISHED}
+    counts = f"{len(status) - left - len(stale)} done, " + (
+        f"{len(stale)} stale (not trained again), " if stale else ""
+    )
+    lines += ["", f"{counts}{left} left; time left: "]
     lines[-1] += time_left_estimate(whole or plan, results, steps_left, started_rates, workers)
     return "\n".join(lines)
 

@@ -29,6 +29,7 @@ from roto.jobs.optuna_ids import storage_id
 from roto.jobs.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 from roto.olympiad.cell import code_commit, run_cell, summary_path
 from roto.olympiad.plan import Cell, Plan, select_cells
+from roto.olympiad.staleness import refuse_stale, stale_cells
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import checkpoint_path
 
@@ -135,8 +136,9 @@ def run_olympiad_worker(
     patterns (``roto.olympiad.plan.select_cells``): enqueue, claim and wait for only those cells,
     leaving the plan's others to workers without them."""
     results = pathlib.Path(results) if results is not None else pathlib.Path(root) / plan.name / "results"
-    study, storage = open_olympiad(plan, root, storage_url)
     chosen = select_cells(plan, only)
+    refuse_stale(chosen, results, root)  # a summary the plan no longer describes is not done
+    study, storage = open_olympiad(plan, root, storage_url)
     enqueue_missing(study, chosen, results)
     wanted = {cell.name for cell in chosen.cells} if only else None
     cells = {cell.name: cell for cell in plan.cells}
@@ -171,8 +173,10 @@ def run_olympiad_worker(
 
 
 def cell_status(plan: Plan, root: str, results: pathlib.Path, storage_url: str | None) -> dict[str, str]:
-    """{cell name: done, running, waiting, failed or not started} without creating anything."""
+    """{cell name: done, stale (its summary trained otherwise than the plan trains it now,
+    ``roto.olympiad.staleness``), running, waiting, failed or not started} without creating anything."""
     status = {c.name: ("done" if summary_path(results, c).is_file() else "not started") for c in plan.cells}
+    status.update(dict.fromkeys(stale_cells(plan, results), "stale"))
     study = find_study(pathlib.Path(root) / plan.name, study_name(plan), storage_url)
     if study is None:
         return status
@@ -181,9 +185,9 @@ def cell_status(plan: Plan, root: str, results: pathlib.Path, storage_url: str |
         ("waiting", (TrialState.WAITING,)),
         ("running", (TrialState.RUNNING,)),
     )
-    # later labels win: a cell failed once and now running is running; done is its summary's to say
+    # later labels win: a cell failed once and now running is running; done and stale, its summary's
     for label, states in by_state:
         for name in cell_trials(study, states):
-            if name in status and status[name] != "done":
+            if name in status and status[name] not in ("done", "stale"):
                 status[name] = label
     return status

@@ -1,0 +1,72 @@
+"""Whether a finished cell's summary still answers its plan.
+
+A worker counts a cell with a summary as done. Should the plan change what the cell trains after
+it finished (another agent config, other training aids, another env count), the summary would
+stand in the table for a run the plan no longer describes. Each summary records the run spec it
+trained (``spec``; a summary written before that records its training aids, ``training_aids``),
+so the plan check can compare it, setting by setting, with what the plan trains the cell with now
+(``roto.rl.run_spec.RunSpec.differences``: the budget and the C threads aside, since a finished
+run may be continued to a longer budget and on other threads).
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+from typing import Any
+
+from roto.envs.aids.settings import parse_aids
+from roto.olympiad.cell import cell_spec, summary_path
+from roto.olympiad.plan import Cell, Plan
+from roto.rl.run_spec import RunSpec
+
+SHOWN = 3
+"""Settings named per cell in a refusal (the rest are counted)."""
+
+
+def summary_differences(plan: Plan, cell: Cell, summary: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
+    """{setting: (the summary's value, the plan's)} where the summary's run trained otherwise than
+    ``plan`` trains ``cell`` now: every setting of the recorded ``spec``, or of a summary without
+    one the training aids it records (``env.aids``); {} where it matches as far as it records."""
+    now = cell_spec(plan, cell)
+    if "spec" in summary:
+        return RunSpec.from_dict(summary["spec"]).differences(now)
+    if "training_aids" in summary and parse_aids(summary["training_aids"]) != now.env.aids:
+        return {"env.aids": (summary["training_aids"], now.env.aids.to_dict())}
+    return {}
+
+
+def stale_cells(plan: Plan, results: pathlib.Path) -> dict[str, dict[str, tuple[Any, Any]]]:
+    """{cell name: its ``summary_differences``} for each of ``plan``'s cells whose summary in
+    ``results`` trained otherwise than the plan trains it now."""
+    stale = {}
+    for cell in plan.cells:
+        path = summary_path(results, cell)
+        if path.is_file():
+            differences = summary_differences(plan, cell, json.loads(path.read_text()))
+            if differences:
+                stale[cell.name] = differences
+    return stale
+
+
+def describe(differences: dict[str, tuple[Any, Any]]) -> str:
+    """``key: summary's value -> plan's value`` for the first ``SHOWN`` settings, and how many more."""
+    shown = [f"{key}: {old!r} -> {new!r}" for key, (old, new) in list(differences.items())[:SHOWN]]
+    more = len(differences) - SHOWN
+    return "; ".join(shown) + (f"; and {more} more" if more > 0 else "")
+
+
+def refuse_stale(plan: Plan, results: pathlib.Path, root: str) -> None:
+    """Raise ValueError naming every cell of ``plan`` whose summary in ``results`` trained otherwise
+    than the plan trains it now, the settings that differ and the ways on; nothing is changed."""
+    stale = stale_cells(plan, results)
+    if not stale:
+        return
+    lines = [f"  {name}: {describe(differences)}" for name, differences in stale.items()]
+    raise ValueError(
+        f"{len(stale)} cell(s) of plan {plan.name!r} have a summary in {str(results)!r} trained with other "
+        "settings than the plan trains them with now (summary's -> plan's):\n" + "\n".join(lines) + "\n"
+        "to train them again, move each summary aside and its run directory "
+        f"({root}/{plan.name}/<cell>, which cannot continue under other settings); "
+        "or restore the plan's settings"
+    )
