@@ -87,7 +87,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
     from roto.jobs.claims import launch_workers
     from roto.jobs.storage import reclaim_now, resolve_storage, storage_in_environment
     from roto.olympiad.plan import load_plan, select_cells
-    from roto.olympiad.staleness import refuse_stale
+    from roto.olympiad.staleness import refuse_stale, retrain_remedy
     from roto.olympiad.worker import enqueue_missing, open_olympiad, run_olympiad_worker
 
     args.storage = resolve_storage(args.storage)
@@ -111,7 +111,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         print(dry_run_report(chosen, args.root, results, args.storage, args.workers, plan if args.only else None))
         return 0
     if args.workers > 1:
-        refuse_stale(chosen, results, args.root)  # before the study is made: nothing changed
+        refuse_stale(chosen, results, retrain_remedy(plan, args.root))  # before the study is made: nothing changed
         # create the study and enqueue the cells once, so the workers only join and claim
         study, storage = open_olympiad(plan, args.root, args.storage)
         if args.reclaim_now:  # here, once: a worker reclaiming would take its siblings' fresh claims

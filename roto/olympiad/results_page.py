@@ -20,6 +20,7 @@ from roto.olympiad.results import (
     variant_agents,
     write_csv,
 )
+from roto.olympiad.staleness import refuse_stale
 from roto.olympiad.submission import with_submissions
 from roto.result_files import write_text_atomic
 
@@ -50,6 +51,13 @@ def write_results(
     summaries in ``source`` and, beside them, the submissions in the folder ``submissions``;
     ``plan``, if given, names the pages and the manifest's configs."""
     summaries = read_summaries(source)
+    if plan is not None:  # a table under the plan's name shows only what the plan trains now
+        refuse_stale(
+            plan,
+            pathlib.Path(source),
+            f"a table of plan {plan.name!r} would show them as its cells: "
+            "move them aside, or restore the plan's settings",
+        )
     if submissions is not None:
         summaries = with_submissions(summaries, submissions)
     name = plan.name if plan else ""

@@ -56,17 +56,22 @@ def describe(differences: dict[str, tuple[Any, Any]]) -> str:
     return "; ".join(shown) + (f"; and {more} more" if more > 0 else "")
 
 
-def refuse_stale(plan: Plan, results: pathlib.Path, root: str) -> None:
+def refuse_stale(plan: Plan, results: pathlib.Path, remedy: str) -> None:
     """Raise ValueError naming every cell of ``plan`` whose summary in ``results`` trained otherwise
-    than the plan trains it now, the settings that differ and the ways on; nothing is changed."""
+    than the plan trains it now, the settings that differ and ``remedy`` (the ways on for the
+    caller); nothing is changed."""
     stale = stale_cells(plan, results)
-    if not stale:
-        return
-    lines = [f"  {name}: {describe(differences)}" for name, differences in stale.items()]
-    raise ValueError(
-        f"{len(stale)} cell(s) of plan {plan.name!r} have a summary in {str(results)!r} trained with other "
-        "settings than the plan trains them with now (summary's -> plan's):\n" + "\n".join(lines) + "\n"
+    if stale:
+        lines = [f"  {name}: {describe(differences)}" for name, differences in stale.items()]
+        raise ValueError(
+            f"{len(stale)} cell(s) of plan {plan.name!r} have a summary in {str(results)!r} trained with other "
+            "settings than the plan trains them with now (summary's -> plan's):\n" + "\n".join(lines) + f"\n{remedy}"
+        )
+
+
+def retrain_remedy(plan: Plan, root: str) -> str:
+    """What a worker refusing stale cells says to do."""
+    return (
         "to train them again, move each summary aside and its run directory "
-        f"({root}/{plan.name}/<cell>, which cannot continue under other settings); "
-        "or restore the plan's settings"
+        f"({root}/{plan.name}/<cell>, which cannot continue under other settings); or restore the plan's settings"
     )

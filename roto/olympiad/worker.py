@@ -29,7 +29,7 @@ from roto.jobs.optuna_ids import storage_id
 from roto.jobs.storage import RETRY_OF_ATTR, fail_stale_trials, find_study, open_storage, reclaim_now, wait_for_running
 from roto.olympiad.cell import code_commit, run_cell, summary_path
 from roto.olympiad.plan import Cell, Plan, select_cells
-from roto.olympiad.staleness import refuse_stale, stale_cells
+from roto.olympiad.staleness import refuse_stale, retrain_remedy, stale_cells
 from roto.rl.evaluation import read_evaluations
 from roto.rl.run_dir import checkpoint_path
 
@@ -137,7 +137,7 @@ def run_olympiad_worker(
     leaving the plan's others to workers without them."""
     results = pathlib.Path(results) if results is not None else pathlib.Path(root) / plan.name / "results"
     chosen = select_cells(plan, only)
-    refuse_stale(chosen, results, root)  # a summary the plan no longer describes is not done
+    refuse_stale(chosen, results, retrain_remedy(plan, root))  # a summary the plan no longer describes is not done
     study, storage = open_olympiad(plan, root, storage_url)
     enqueue_missing(study, chosen, results)
     wanted = {cell.name for cell in chosen.cells} if only else None

@@ -70,6 +70,11 @@ def test_the_dry_run_lists_a_stale_cell_with_the_settings_it_trained_otherwise(t
     assert main([*argv, "--only", "baoding-shadow-blind-*"]) == 2  # one stale cell among those chosen
     assert f"{committed.stem}: env.aids: " in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["results"]  # nothing made
+    out = ["--out", str(tmp_path / "tables")]
+    assert main(["results", str(tmp_path / "results"), "--plan", "benchmark", *out]) == 2
+    assert "a table of plan 'benchmark' would show them as its cells" in capsys.readouterr().err
+    assert not (tmp_path / "tables").exists()
+    assert main(["results", str(tmp_path / "results"), *out]) == 0  # the summaries' own table
 
 
 def test_a_summary_without_a_recorded_spec_is_compared_by_the_training_aids_it_records(trained):
