@@ -11,13 +11,13 @@ run may be continued to a longer budget and on other threads).
 
 from __future__ import annotations
 
-import json
 import pathlib
 from typing import Any
 
 from roto.envs.aids.settings import parse_aids
 from roto.olympiad.cell import cell_spec, summary_path
 from roto.olympiad.plan import Cell, Plan
+from roto.result_files import read_json
 from roto.rl.run_spec import RunSpec
 
 SHOWN = 3
@@ -42,11 +42,21 @@ def stale_cells(plan: Plan, results: pathlib.Path) -> dict[str, dict[str, tuple[
     stale = {}
     for cell in plan.cells:
         path = summary_path(results, cell)
-        if path.is_file():
-            differences = summary_differences(plan, cell, json.loads(path.read_text()))
-            if differences:
-                stale[cell.name] = differences
+        if path.is_file() and (differences := recorded_differences(plan, cell, path)):
+            stale[cell.name] = differences
     return stale
+
+
+def recorded_differences(plan: Plan, cell: Cell, path: pathlib.Path) -> dict[str, tuple[Any, Any]]:
+    """``summary_differences`` of the summary at ``path``; ValueError naming the file where it is not
+    a JSON object or its ``spec`` or ``training_aids`` do not read as a run spec and aids."""
+    summary = read_json(path, "cell summary")
+    if not isinstance(summary, dict):
+        raise ValueError(f"cell summary {str(path)!r} should be a JSON object, found {type(summary).__name__}")
+    try:
+        return summary_differences(plan, cell, summary)
+    except (KeyError, TypeError, ValueError) as error:
+        raise ValueError(f"cell summary {str(path)!r}: its recorded spec does not read ({error})") from None
 
 
 def describe(differences: dict[str, tuple[Any, Any]]) -> str:

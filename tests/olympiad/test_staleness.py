@@ -88,6 +88,20 @@ def test_a_summary_without_a_recorded_spec_is_compared_by_the_training_aids_it_r
     assert summary_differences(plan, cell, summary) == {}  # nothing recorded to compare
 
 
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [("[]", "should be a JSON object, found list"), ('{"spec": {"env": {}}}', "its recorded spec does not read"),
+     ('{"training_aids": {"warp_drive": {}}}', "unknown training aid aids.warp_drive"),
+     ("{", "is not valid JSON at line 1, column 2")],
+)  # fmt: skip
+def test_a_summary_that_does_not_read_is_refused_naming_its_file(trained, text, said):
+    plan, _, _, results, cell = trained
+    (results / f"{cell.name}.json").write_text(text)
+    with pytest.raises(ValueError, match=said) as refused:
+        stale_cells(plan, results)
+    assert f"{cell.name}.json" in str(refused.value)
+
+
 def test_a_longer_budget_alone_is_no_difference(trained):
     plan, _, _, results, _ = trained
     longer = load_plan(str(write_toy_plan(results.parents[2], updates=4, seeds=(0,))))
