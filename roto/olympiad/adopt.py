@@ -2,9 +2,9 @@
 another (the benchmark) counts as that cell, so that no seed is trained twice.
 
 "Exactly" is the run spec (the one the summary records it trained; for a summary written before
-summaries recorded it, the source plan's ``cell_spec``): task, hand, obs mode, agent config and overrides, training
-aids, seed, env count and backend, compared setting by setting, and the env-step budget (the C
-threads may differ: they step the same worlds to the same states). The summary is
+summaries recorded it, the source plan's ``cell_spec``): task, hand, obs mode, agent config and
+overrides, training aids, seed, env count and backend, compared setting by setting, and the
+env-step budget (the C threads may differ: they step the same worlds to the same states). The summary is
 copied under the other plan's cell name with its ``variant``, ``plan`` and ``agent`` as that plan
 would have written them, and ``adopted_from`` naming the plan, cell and agent it was trained as;
 everything it measured is kept as it is.
@@ -18,6 +18,7 @@ import pathlib
 from roto.olympiad.cell import agent_record, cell_spec, summary_path
 from roto.olympiad.plan import Cell, Plan
 from roto.olympiad.results import read_summaries
+from roto.olympiad.staleness import recorded_spec
 from roto.result_files import write_text_atomic
 from roto.rl.run_spec import RunSpec
 
@@ -60,8 +61,7 @@ def adopt_cells(
                 f"summary {source.name} in {str(source_results)!r}: plan {source_plan.name!r} has no variant "
                 f"{source.variant!r}; valid variants: {sorted(source_plan.variants)}"
             )
-        trained = RunSpec.from_dict(summary["spec"]) if "spec" in summary else None
-        target = same_run(source_plan, source, target_plan, trained)
+        target = same_run(source_plan, source, target_plan, recorded_spec(summary, source.name))
         if target is not None and not summary_path(target_results, target).is_file():
             adoptions.append((target, adopted_summary(summary, source_plan, source, target_plan, target)))
     if adoptions:

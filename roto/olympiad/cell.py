@@ -4,12 +4,12 @@ The run directory is ``<root>/<plan>/<cell>`` (an ordinary run: ``roto eval``, `
 ``roto train --resume`` work on it); a cell whose run has a checkpoint continues from it. The
 summary, ``<results>/<cell>.json``, is small enough to commit: the evaluation curve, the training
 scalars between evaluations (the policy's action std, the training episodes' return, length and
-task metrics), the training aids its run used and its whole run spec, the final and best policies' evaluations over the
-plan's episodes (per-episode returns and task metrics included), the training wall time, the
-commit that wrote it and the commits that trained it: each start of training appends its commit
-and the env steps it started from to ``<run_dir>/commits.jsonl`` (``TRAINED_BY``), so a cell
-resumed across commits names each. ``roto results`` reads only summaries, so cells trained on
-other machines or in other sittings combine.
+task metrics), the training aids its run used and its whole run spec, the final and best
+policies' evaluations over the plan's episodes (per-episode returns and task metrics included),
+the training wall time, the commit that wrote it and the commits that trained it: each start of
+training appends its commit and the env steps it started from to ``<run_dir>/commits.jsonl``
+(``TRAINED_BY``), so a cell resumed across commits names each. ``roto results`` reads only
+summaries, so cells trained on other machines or in other sittings combine.
 """
 
 from __future__ import annotations

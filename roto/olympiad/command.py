@@ -208,10 +208,8 @@ def dry_run_report(
     if left and journal is not None and not journal.is_file():
         lines += ["", f"no workers' journal at {journal}: a cell running under another --root shows as not started"]
     steps_left = {name: budgets[name] - done_steps[name] for name, state in status.items() if state not in FINISHED}
-    counts = f"{len(status) - left - len(stale)} done, " + (
-        f"{len(stale)} stale (not trained again), " if stale else ""
-    )
-    lines += ["", f"{counts}{left} left; time left: "]
+    kept = f"{len(stale)} stale (not trained again), " if stale else ""
+    lines += ["", f"{len(status) - left - len(stale)} done, {kept}{left} left; time left: "]
     lines[-1] += time_left_estimate(whole or plan, results, steps_left, started_rates, workers)
     return "\n".join(lines)
 

@@ -30,7 +30,7 @@ def summary_differences(plan: Plan, cell: Cell, summary: dict[str, Any]) -> dict
     one the training aids it records (``env.aids``); {} where it matches as far as it records."""
     now = cell_spec(plan, cell)
     if "spec" in summary:
-        return RunSpec.from_dict(summary["spec"]).differences(now)
+        return RunSpec.from_dict(summary["spec"]).differences(now)  # recorded_differences names a bad one
     if "training_aids" in summary and parse_aids(summary["training_aids"]) != now.env.aids:
         return {"env.aids": (summary["training_aids"], now.env.aids.to_dict())}
     return {}
@@ -57,6 +57,17 @@ def recorded_differences(plan: Plan, cell: Cell, path: pathlib.Path) -> dict[str
         return summary_differences(plan, cell, summary)
     except (KeyError, TypeError, ValueError) as error:
         raise ValueError(f"cell summary {str(path)!r}: its recorded spec does not read ({error})") from None
+
+
+def recorded_spec(summary: dict[str, Any], where: str) -> RunSpec | None:
+    """The run spec ``summary`` records it trained, None where it records none (written before
+    summaries did); ValueError naming ``where`` where it does not read as one."""
+    if "spec" not in summary:
+        return None
+    try:
+        return RunSpec.from_dict(summary["spec"])
+    except (KeyError, TypeError, ValueError) as error:
+        raise ValueError(f"cell summary {where}: its recorded spec does not read ({error})") from None
 
 
 def describe(differences: dict[str, tuple[Any, Any]]) -> str:

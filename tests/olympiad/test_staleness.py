@@ -17,6 +17,16 @@ from tests.rl.toy_env import ToyEnv
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
+def with_bounce_metric(path: pathlib.Path) -> dict:
+    """The toy env's summary at ``path`` rewritten with the Bounce metric ``roto results`` reads
+    (0 bounces in every record); returned."""
+    summary = json.loads(path.read_text())
+    for record in (summary["final"], summary["best"], *summary["evaluations"]):
+        record["bounces_mean"] = 0.0
+    path.write_text(json.dumps(summary))
+    return summary
+
+
 @pytest.fixture
 def trained(tmp_path):
     """The toy plan's first cell trained (2 updates), and the plan file rewritten to train every
@@ -110,11 +120,7 @@ def test_a_longer_budget_alone_is_no_difference(trained):
 
 def test_a_cell_is_adopted_by_the_spec_its_summary_records_not_by_its_plans_settings_now(trained, tmp_path):
     plan, changed, _, results, cell = trained
-    path = results / f"{cell.name}.json"
-    summary = json.loads(path.read_text())  # the toy env's, with the Bounce metric roto results reads
-    for record in (summary["final"], summary["best"], *summary["evaluations"]):
-        record["bounces_mean"] = 0.0
-    path.write_text(json.dumps(summary))
+    with_bounce_metric(results / f"{cell.name}.json")
     (tmp_path / "bench").mkdir()
     bench = load_plan(str(write_toy_plan(tmp_path / "bench", updates=2, seeds=(0,))))  # the cell as it trained
     # its plan now trains 2 epochs; the summary records the 1 it trained, as the bench cell does
@@ -126,3 +132,12 @@ def test_every_committed_benchmark_summary_trained_what_the_benchmark_plan_train
     """A change to a packaged recipe that the benchmark's finished cells did not train with fails
     here, before a table would mix the two."""
     assert stale_cells(load_plan("benchmark"), ROOT / "benchmarks" / "results" / "benchmark" / "cells") == {}
+
+
+def test_adopting_a_summary_whose_recorded_spec_does_not_read_is_refused_naming_it(trained, tmp_path):
+    plan, _, _, results, cell = trained
+    path = results / f"{cell.name}.json"
+    path.write_text(json.dumps({**with_bounce_metric(path), "spec": {"env": {}}}))
+    with pytest.raises(ValueError, match=f"cell summary {cell.name}: its recorded spec does not read"):
+        adopt_cells(plan, results, plan, tmp_path / "elsewhere")
+    assert not (tmp_path / "elsewhere").exists()
