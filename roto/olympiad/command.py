@@ -36,7 +36,8 @@ def add_olympiad_parsers(sub: argparse._SubParsersAction) -> None:
         "--dry_run",
         dest="dry_run",
         action="store_true",
-        help="list the cells, which are done, and the time left; train nothing",
+        help="list the cells, which are done or stale (trained otherwise than the plan now says), and the "
+        "time left; train nothing",
     )
     p.add_argument(
         "--only",
