@@ -9,7 +9,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from roto.olympiad.results import Agents, Key, markdown_table, metric
+from roto.olympiad.results import Agents, Key, markdown_table, metric, scores_by_cell
 from roto.tasks import get_task
 
 
@@ -107,6 +107,14 @@ def lead_scores(summaries: list[dict], policy: str = "best") -> tuple[dict[Key, 
             found.update({(task, *row): v for row, v in measure_scores(summaries, task, lead, policy).items()})
     scores = {key: v for key, v in sorted(found.items()) if v is not None}
     return scores, sorted(key for key, v in found.items() if v is None)
+
+
+def lead_measure_scores(summaries: list[dict]) -> dict[Key, np.ndarray]:
+    """{cell: (seeds,) the best policies' lead measure}: Baoding's round rotations
+    (``lead_scores``; a cell whose summaries cannot tell them is left out), every other task's
+    headline metric. What the probabilities of improvement compare."""
+    headline = {key: v for key, v in scores_by_cell(summaries, "best").items() if not get_task(key[0]).selection_metric}
+    return {**headline, **lead_scores(summaries, "best")[0]}
 
 
 def lead_section(summaries: list[dict], agents: Agents, current: set[str]) -> list[str]:

@@ -57,11 +57,18 @@ def lead_measure(task: str) -> str:
     return lead_metric(get_task(task))
 
 
+LABEL_COMMITS = 3
+"""A page label names at most this many commits; beyond, it counts them (manifest.csv names each cell's)."""
+
+
 def page_label(summaries: list[dict], plan: str = "") -> str:
     """ "plan <name>, commit <c1>, <c2>" of a folder of summaries: the commits that wrote them and
-    those that trained them (``plan``: a name or file that wins over the plan the summaries record)."""
+    those that trained them, or "plan <name>, <n> commits, each cell's in manifest.csv" beyond
+    ``LABEL_COMMITS`` (``plan``: a name or file that wins over the plan the summaries record)."""
     commits = sorted({c for s in summaries for c in (s["commit"], *(t["commit"] for t in s.get("trained_by", [])))})
-    return f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
+    if len(commits) <= LABEL_COMMITS:
+        return f"plan {plan or summaries[0]['plan']}, commit {', '.join(commits)}"
+    return f"plan {plan or summaries[0]['plan']}, {len(commits)} commits, each cell's in manifest.csv"
 
 
 def variant_agents(summaries: list[dict], plan: str = "") -> Agents:

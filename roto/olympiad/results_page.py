@@ -7,7 +7,7 @@ import pathlib
 
 from roto.cli_errors import check_output_path
 from roto.olympiad.manifest import write_manifest
-from roto.olympiad.path_results import lead_section, path_metric_table
+from roto.olympiad.path_results import lead_measure_scores, lead_section, path_metric_table
 from roto.olympiad.plan import Plan
 from roto.olympiad.results import (
     current_tasks,
@@ -27,7 +27,8 @@ from roto.result_files import write_text_atomic
 
 def results_markdown(summaries: list[dict], plan: str = "") -> str:
     """results.md of ``summaries``: the lead measures, each policy's table, the path metrics and the
-    probabilities of improvement (what ``write_results`` writes, without the CSVs and curves)."""
+    probabilities of improvement, on the lead measures of the best policies as the tables lead
+    (what ``write_results`` writes, without the CSVs and curves)."""
     agents = variant_agents(summaries, plan or summaries[0].get("plan", ""))
     current = current_tasks(summaries)
     md = [f"# Olympiad results ({page_label(summaries, plan)})", "", *lead_section(summaries, agents, current)]
@@ -36,9 +37,9 @@ def results_markdown(summaries: list[dict], plan: str = "") -> str:
         heading += ", mean ± std over seeds"
         md += [heading, "", markdown_table(scores_by_cell(summaries, policy), agents, current), ""]
     md += path_metric_table(summaries)
-    pairs = improvements(scores_by_cell(summaries, "final"))
+    pairs = improvements(lead_measure_scores(summaries))
     if pairs:
-        md += ["## Probability of improvement (final policies; variants with two or more seeds)", ""]
+        md += ["## Probability of improvement (best policies, lead measure; variants with two or more seeds)", ""]
         md += [f"- {t} / {r} / {o}: P({x} > {y}) = {p:.2f}" for t, r, o, x, y, p in pairs]
     return "\n".join(md) + "\n"
 

@@ -51,7 +51,7 @@ def test_results_match_hand_computed_statistics(tmp_path, capsys):
     assert "| bounce (v0) / blind / fd: a swept FD | bounce (v0) / blind / ppo: roto's PPO |" in md
     assert "| roto v1, Shadow, 200 M steps (5 seeds) | 5.1 (ppo) |  | 69.0 (ppo) |  |  |" in md
     assert "| reference controller (rotations, v1) | scripted Bounce (bounces, v0) |" in md
-    # P(fd > ppo) on Shadow Bounce: 25 beats 10 and 20, 35 beats 10, 20 and 30: 5 of 8 pairs
+    # P(fd > ppo) on Shadow Bounce's best policies: 25 beats 11 and 21, 40 beats 11, 21 and 31: 5 of 8 pairs
     assert "bounce / shadow / blind: P(fd > ppo) = 0.62" in md
     assert (out / "curves_bounce_shadow.png").stat().st_size > 0 and (out / "curves_baoding_allegro.png").is_file()
     # the action std plotted only where summaries keep it
@@ -195,3 +195,30 @@ def test_baoding_results_lead_with_round_rotations_where_every_seed_measured_the
     section = md[md.index("## best policy: baoding") : md.index("## final policy")]
     assert "| allegro | 0.2 (n=1) |" in section and "Not measured" not in section
     assert "| allegro | 2.0 (n=1) |" in md[md.index("## best policy: the task's") :]  # roto's count stays below
+
+
+def test_probabilities_of_improvement_compare_round_rotations_not_roto_count(tmp_path):
+    """A variant that swings the balls out and back scores more swaps than one that goes round: the
+    probability of improvement, like the tables it follows, ranks the best policies' round rotations."""
+    from roto.olympiad.results_page import results_markdown
+
+    summaries = []
+    for variant, rotations, round_rotations in (("swing", 14.0, 0.25), ("round", 11.0, 11.0)):
+        for seed in (0, 1):
+            best = {"rotations_mean": rotations + seed, "round_rotations_mean": round_rotations + seed}
+            summaries.append({"task": "baoding", "robot": "shadow", "obs": "blind", "variant": variant, "seed": seed,
+                              "plan": "toy", "commit": "abc1234", "env_steps": 2000, "evaluations": [],
+                              "final": {"rotations_mean": rotations + seed}, "best": best,
+                              "task_version": 1})  # fmt: skip
+    md = results_markdown(summaries)
+    section = md[md.index("## Probability of improvement (best policies, lead measure;") :]
+    assert "baoding / shadow / blind: P(round > swing) = 1.00" in section
+
+
+def test_a_page_label_counts_the_commits_beyond_three():
+    from roto.olympiad.results import page_label
+
+    summaries = [{"plan": "toy", "commit": c} for c in ("a1", "b2", "c3")]
+    assert page_label(summaries) == "plan toy, commit a1, b2, c3"
+    summaries.append({"plan": "toy", "commit": "d4", "trained_by": [{"commit": "e5", "from_env_steps": 0}]})
+    assert page_label(summaries, "benchmark") == "plan benchmark, 5 commits, each cell's in manifest.csv"
