@@ -197,7 +197,7 @@ def test_baoding_results_lead_with_round_rotations_where_every_seed_measured_the
     assert "| allegro | 2.0 (n=1) |" in md[md.index("## best policy: the task's") :]  # roto's count stays below
 
 
-def test_probabilities_of_improvement_compare_round_rotations_not_roto_count(tmp_path):
+def test_probabilities_of_improvement_compare_round_rotations_not_roto_count():
     """A variant that swings the balls out and back scores more swaps than one that goes round: the
     probability of improvement, like the tables it follows, ranks the best policies' round rotations."""
     from roto.olympiad.results_page import results_markdown
