@@ -221,11 +221,14 @@ def time_left_estimate(
     """How long ``steps_left`` (env steps left per unfinished cell of ``plan``) takes: each cell
     at its task's finished cells' throughput (the plan's summaries in ``results``), a task with
     none at all the finished cells' throughput, or with none finished at the started cells' latest
-    throughput; for one worker, and with several, until the busiest one is done."""
+    throughput; for one worker, and with several, until the busiest one is done ("none" when no
+    cell is left)."""
     from roto.olympiad.plan import Cell
     from roto.olympiad.results import read_summaries
     from roto.olympiad.time_left import busiest_worker_load, cell_seconds, rate_sources, task_throughputs, throughput
 
+    if not steps_left:
+        return "none, every cell has finished"
     cells = set(plan.cells)
     try:
         summaries = [s for s in read_summaries(results) if Cell.of_summary(s) in cells]

@@ -849,3 +849,12 @@ def test_the_lean_recipe_is_baoding_cpu_with_its_two_bank_aids_off_on_every_hand
     }  # fmt: skip
     for cell in plan.cells:
         assert switched_off(plan, cell) == {"env.aids.replayed_starts": None, "env.aids.round_swaps": None}
+
+
+def test_dry_run_of_a_finished_plan_says_no_time_is_left(capsys):
+    """The committed benchmark cells are the whole plan: nothing left, no rate to estimate at."""
+    from roto.cli import main
+
+    results = ROOT / "benchmarks" / "results" / "benchmark" / "cells"
+    assert main(["olympiad", "benchmark", "--dry-run", "--results", str(results)]) == 0
+    assert "80 done, 0 left; time left: none, every cell has finished" in capsys.readouterr().out
