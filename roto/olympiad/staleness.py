@@ -24,16 +24,24 @@ SHOWN = 3
 """Settings named per cell in a refusal (the rest are counted)."""
 
 
-def summary_differences(plan: Plan, cell: Cell, summary: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
+def summary_differences(
+    plan: Plan, cell: Cell, summary: dict[str, Any], where: str = "(given)"
+) -> dict[str, tuple[Any, Any]]:
     """{setting: (the summary's value, the plan's)} where the summary's run trained otherwise than
     ``plan`` trains ``cell`` now: every setting of the recorded ``spec``, or of a summary without
-    one the training aids it records (``env.aids``); {} where it matches as far as it records."""
+    one the training aids it records (``env.aids``); {} where it matches as far as it records.
+    ValueError naming ``where`` (the summary) where its spec or aids do not read."""
     now = cell_spec(plan, cell)
-    if "spec" in summary:
-        return RunSpec.from_dict(summary["spec"]).differences(now)  # recorded_differences names a bad one
-    if "training_aids" in summary and parse_aids(summary["training_aids"]) != now.env.aids:
-        return {"env.aids": (summary["training_aids"], now.env.aids.to_dict())}
-    return {}
+    trained = recorded_spec(summary, where)
+    if trained is not None:
+        return trained.differences(now)
+    if "training_aids" not in summary:
+        return {}
+    try:
+        aids = parse_aids(summary["training_aids"])
+    except ValueError as error:
+        raise ValueError(f"cell summary {where}: its recorded training aids do not read ({error})") from None
+    return {} if aids == now.env.aids else {"env.aids": (summary["training_aids"], now.env.aids.to_dict())}
 
 
 def stale_cells(plan: Plan, results: pathlib.Path) -> dict[str, dict[str, tuple[Any, Any]]]:
@@ -53,10 +61,7 @@ def recorded_differences(plan: Plan, cell: Cell, path: pathlib.Path) -> dict[str
     summary = read_json(path, "cell summary")
     if not isinstance(summary, dict):
         raise ValueError(f"cell summary {str(path)!r} should be a JSON object, found {type(summary).__name__}")
-    try:
-        return summary_differences(plan, cell, summary)
-    except (KeyError, TypeError, ValueError) as error:
-        raise ValueError(f"cell summary {str(path)!r}: its recorded spec does not read ({error})") from None
+    return summary_differences(plan, cell, summary, repr(str(path)))
 
 
 def recorded_spec(summary: dict[str, Any], where: str) -> RunSpec | None:
