@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 
 from roto.envs.config import EnvConfig
+from roto.eval.bounce_rhythm import rhythm
 from roto.sim.scene import PHYSICS_DT
 from roto.tasks.bounce import BALL, bounce_counter
 
@@ -63,14 +64,14 @@ def harmonic_path(period_steps: float, coef: np.ndarray):
 
 def plate_episode(path) -> dict[str, float]:
     """One 600-step episode of the ball on the plate moved along ``path``: bounces by the task's rule,
-    the mean touch and flight (control steps) after the first two of each."""
+    the mean touch and flight (control steps) of the counted bounces (``roto.eval.bounce_rhythm``)."""
     model = mujoco.MjModel.from_xml_string(
         PLATE_XML.format(dt=PHYSICS_DT, radius=BALL.radius, mass=BALL.mass, friction=BALL.friction)
     )
     data, force = mujoco.MjData(model), np.zeros(6)
     data.qpos[1:5] = [0.0, 0.0, path(0.0)[0] + BALL.radius + 0.005, 1.0]
     prev, waiting, free = np.array(False), np.array(False), np.array(0)
-    contacts, bounces = [], 0
+    contact, bounce, height = [], [], []
     for _ in range(EPISODE_STEPS):
         touched = False
         for _ in range(SUBSTEPS):
@@ -79,25 +80,15 @@ def plate_episode(path) -> dict[str, float]:
             for i in range(data.ncon):
                 mujoco.mj_contactForce(model, data, i, force)
                 touched |= abs(force[0]) > THRESHOLD
-        bounce, waiting, free = bounce_counter(np.array(touched), prev, waiting, free)
-        bounces += int(bounce)
+        counted, waiting, free = bounce_counter(np.array(touched), prev, waiting, free)
         prev = np.array(touched)
-        contacts.append(touched)
+        contact.append(touched)
+        bounce.append(bool(counted))
+        height.append(float(data.qpos[3]))
         if data.qpos[3] < path(data.time)[0] - 0.1:  # the ball fell off the plate
             break
-    return {"bounces": bounces, **touch_and_flight(np.array(contacts))}
-
-
-def touch_and_flight(contact: np.ndarray) -> dict[str, float]:
-    """Mean length (steps) of the touches and flights of ``contact`` (T,) bool, the first two of each
-    (the drop from the start) left out."""
-    edges = np.flatnonzero(np.diff(contact.astype(np.int8))) + 1
-    runs = np.diff(np.concatenate([[0], edges, [len(contact)]]))
-    first = bool(contact[0])
-    touches = runs[0 if first else 1 :: 2][2:]
-    flights = runs[1 if first else 0 :: 2][2:]
-    mean = lambda x: float(np.mean(x)) if len(x) else float("nan")  # noqa: E731
-    return {"touch_steps": mean(touches), "flight_steps": mean(flights)}
+    figures = rhythm(*(np.array(x)[:, None] for x in (contact, bounce, height)), np.array([len(contact)]))
+    return {name: figures[name] for name in ("bounces", "touch_steps", "flight_steps")}
 
 
 def path_limits(period_steps: float, coef: np.ndarray) -> dict[str, float]:
@@ -146,7 +137,7 @@ def main() -> None:
     for kind, period, make in runs:
         r = figures[kind][period] = make()
         print(
-            f"| {kind} | {period} | {r['bounces']} | {r['touch_steps']:.2f} | {r['flight_steps']:.2f} | "
+            f"| {kind} | {period} | {r['bounces']:.0f} | {r['touch_steps']:.2f} | {r['flight_steps']:.2f} | "
             f"{r['stroke_cm']:.1f} | {r['speed']:.2f} | {r['accel']:.0f} |",
             flush=True,
         )
