@@ -11,6 +11,8 @@ import pathlib
 from collections.abc import Iterator
 from typing import Any
 
+from roto.text_files import read_text
+
 
 @contextlib.contextmanager
 def replacing(path: str | pathlib.Path) -> Iterator[pathlib.Path]:
@@ -35,19 +37,11 @@ def read_json(path: str | pathlib.Path, what: str = "JSON file") -> Any:
     """The data of ``path``.
 
     Raises:
-        FileNotFoundError when it does not exist; ValueError naming ``what`` and the file when it is not
-        text (a binary file), with the line and column when it is not valid JSON.
+        FileNotFoundError when it does not exist; ValueError naming ``what`` and the file when it cannot
+        be read or is not text (``roto.text_files.read_text``), with the line and column when it is not
+        valid JSON.
     """
-    path = pathlib.Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise FileNotFoundError(f"{what} {str(path)!r} does not exist") from None
-    except UnicodeDecodeError as error:
-        raise ValueError(
-            f"{what} {str(path)!r} is not JSON text: byte {error.start} ({error.object[error.start]:#04x}) "
-            "is not UTF-8; is it a binary file?"
-        ) from None
+    text = read_text(path, what, "JSON")
     try:
         return json.loads(text)
     except json.JSONDecodeError as error:

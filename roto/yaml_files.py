@@ -9,6 +9,8 @@ from typing import Any
 
 import yaml
 
+from roto.text_files import read_text
+
 
 class _DuplicateKey(yaml.YAMLError):
     """A mapping names one key twice: YAML keeps the last silently, roto refuses it."""
@@ -36,14 +38,7 @@ def read_yaml(path: str | pathlib.Path, what: str = "YAML file") -> Any:
         FileNotFoundError when ``path`` does not exist; ValueError naming ``what`` and the file
         when it cannot be read or is not valid YAML (with the line and column of the problem).
     """
-    path = pathlib.Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise FileNotFoundError(f"{what} {str(path)!r} does not exist") from None
-    except (OSError, UnicodeDecodeError) as error:
-        reason = getattr(error, "strerror", None) or str(error)
-        raise ValueError(f"{what} {str(path)!r} cannot be read: {reason}") from None
+    text = read_text(path, what, "YAML")
     try:
         return yaml.load(text, Loader=_UniqueKeyLoader)  # a SafeLoader: plain data only
     except _DuplicateKey as error:

@@ -252,11 +252,15 @@ def time_left_estimate(
 
 def cmd_pages(pages: list[str]) -> int:
     """Rewrite each page's generated tables (``roto.olympiad.reference_tables.refresh_blocks``;
-    sources relative to the current directory, the repository's root)."""
-    from roto.olympiad.reference_tables import refresh_blocks
+    sources relative to the current directory, the repository's root); nothing is written unless
+    every page reads, holds generated blocks that all read, and every table can be made."""
+    from roto.olympiad.reference_tables import check_blocks, refresh_blocks
     from roto.result_files import write_text_atomic
+    from roto.text_files import read_text
 
-    texts = {page: pathlib.Path(page).read_text(encoding="utf-8") for page in pages}  # every page read first
+    texts = {page: read_text(page, "page") for page in pages}  # every page read and checked first
+    for page, text in texts.items():
+        check_blocks(text, page)
     fresh = {page: refresh_blocks(text, ".") for page, text in texts.items()}  # then every table made
     changed = [page for page in pages if fresh[page] != texts[page]]
     for page in changed:

@@ -359,3 +359,38 @@ def refresh_blocks(text: str, root: str | pathlib.Path) -> str:
         return f"{opening}{TABLES[kind](summaries, plan, options)}\n{match.group(6)}"
 
     return BLOCK.sub(table, text)
+
+
+OPENING = re.compile(r"^<!-- roto results:", re.MULTILINE)
+
+
+def check_blocks(text: str, page: str) -> int:
+    """How many generated blocks ``page`` (its ``text``) holds; ValueError naming the page when it
+    holds none, or the line of an opening that does not read as one (a typo in it) or of a block
+    not closed before the next block opens, where refreshing would leave a stale table unnoticed."""
+
+    def line(index: int) -> int:
+        return text.count("\n", 0, index) + 1
+
+    blocks = [match.span() for match in BLOCK.finditer(text)]
+    starts = {start for start, _ in blocks}
+    for index in (match.start() for match in OPENING.finditer(text)):
+        if index in starts:
+            continue
+        enclosing = [start for start, end in blocks if start < index < end]
+        if enclosing:
+            raise ValueError(
+                f"page {page!r}, line {line(enclosing[0])}: the generated block opened there has no "
+                f"'<!-- /roto results -->' before the next block opens, at line {line(index)}"
+            )
+        opening = text[index:].split("\n", 1)[0]
+        raise ValueError(
+            f"page {page!r}, line {line(index)}: {opening!r} does not open a generated block; write "
+            "'<!-- roto results: KIND SOURCE[ option=value ...] -->', the table, then '<!-- /roto results -->'"
+        )
+    if not blocks:
+        raise ValueError(
+            f"page {page!r} holds no generated block ('<!-- roto results: KIND SOURCE -->' ... "
+            "'<!-- /roto results -->'): nothing in it to refresh"
+        )
+    return len(blocks)

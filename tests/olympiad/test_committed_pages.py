@@ -7,7 +7,7 @@ import pathlib
 
 import pytest
 
-from roto.olympiad.reference_tables import refresh_blocks
+from roto.olympiad.reference_tables import OPENING, check_blocks, refresh_blocks
 from roto.olympiad.results import read_summaries
 from roto.olympiad.results_page import results_markdown
 
@@ -49,13 +49,14 @@ def test_a_committed_page_is_what_its_summaries_generate(page):
 GENERATED = sorted(
     str(path.relative_to(ROOT))
     for path in [ROOT / "README.md", *(ROOT / "docs").glob("*.md"), *(ROOT / "experiments").rglob("*.md")]
-    if "<!-- roto results: " in path.read_text()
+    if OPENING.search(path.read_text())  # a block's opening at a line's start, not one quoted in prose
 )
 
 
 @pytest.mark.parametrize("page", GENERATED)
 def test_the_generated_tables_of_a_page_are_what_their_summaries_generate(page):
     text = (ROOT / page).read_text()
+    assert check_blocks(text, page) >= 1  # every opening of the page reads as a block, each closed
     assert refresh_blocks(text, ROOT) == text, f"run: roto results --pages {page}"
 
 

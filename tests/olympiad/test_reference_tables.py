@@ -6,7 +6,7 @@ import pytest
 from roto.cli import main
 from roto.olympiad.manifest import manifest_rows
 from roto.olympiad.plan import load_plan
-from roto.olympiad.reference_tables import overview_table, refresh_blocks, seeds_table, task_table
+from roto.olympiad.reference_tables import check_blocks, overview_table, refresh_blocks, seeds_table, task_table
 
 
 def summary(task, robot, obs, variant, seed, best, **extra):
@@ -128,6 +128,33 @@ def test_pages_refresh_their_generated_blocks_from_one_or_more_folders(tmp_path,
     assert main(["results", "--pages", "page.md"]) == 2
     valid = "['baoding', 'bounce', 'orderings', 'overview', 'seeds', 'variants']"
     assert f"unknown kind 'pie'; valid: {valid}" in capsys.readouterr().err
+
+
+def test_pages_that_cannot_be_refreshed_are_refused_naming_the_page_and_nothing_is_written(
+    tmp_path, monkeypatch, capsys
+):
+    write_folder(tmp_path / "a", SUMMARIES[:5])
+    good = "<!-- roto results: overview a -->\nstale\n<!-- /roto results -->\n"
+    (tmp_path / "good.md").write_text(good)
+    (tmp_path / "folder.md").mkdir()
+    (tmp_path / "prose.md").write_text("# no table here; `<!-- roto results: KIND SOURCE -->` in prose\n")
+    (tmp_path / "typo.md").write_text(good + "\n<!-- roto results: overview -->\n<!-- /roto results -->\n")
+    (tmp_path / "unclosed.md").write_text("<!-- roto results: overview a -->\nstale\n\n" + good)
+    monkeypatch.chdir(tmp_path)
+    refused = {
+        "missing.md": "page 'missing.md' does not exist",
+        "folder.md": "page 'folder.md' cannot be read: it is a folder; give a file",
+        "prose.md": "page 'prose.md' holds no generated block",
+        "typo.md": "page 'typo.md', line 5: '<!-- roto results: overview -->' does not open a generated block",
+        "unclosed.md": "page 'unclosed.md', line 1: the generated block opened there has no '<!-- /roto results -->' "
+        "before the next block opens, at line 4",
+    }
+    for page, expected in refused.items():
+        assert main(["results", "--pages", "good.md", page]) == 2, page
+        err = capsys.readouterr().err
+        assert expected in err and len(err.strip().splitlines()) == 1, (page, err)
+        assert (tmp_path / "good.md").read_text() == good  # the page before it is left as it was
+    assert check_blocks(good, "good.md") == 1
 
 
 def test_the_manifest_names_each_cells_config_aids_commit_and_task_version(tmp_path):
