@@ -81,6 +81,31 @@ CASES = {
         "nosuch",
     ),
     "zero workers": (lambda d: ["olympiad", "benchmark", "--root", str(d / "o"), "--workers", "0"], 2, "--workers"),
+    "zero torch threads per cell": (
+        lambda d: ["olympiad", "benchmark", "--root", str(d / "o"), "--torch_threads", "0", "--dry-run"],
+        2,
+        "--torch_threads must be an integer >= 1, got 0",
+    ),
+    "a heartbeat of no time": (
+        lambda d: ["olympiad", "benchmark", "--root", str(d / "o"), "--heartbeat", "0"],
+        2,
+        "--heartbeat must be a number of seconds > 0, got 0.0",
+    ),
+    "negative torch threads per trial": (
+        lambda d: ["sweep", "--study", "s", "--root", str(d / "sweeps"), "--torch_threads", "-2"],
+        2,
+        "--torch_threads must be an integer >= 1, got -2",
+    ),
+    "a page to refresh that is a folder": (
+        lambda d: ["results", "--pages", str(d)],
+        2,
+        "cannot be read: it is a folder; give a file",
+    ),
+    "a submission to check that is a folder": (
+        lambda d: ["results", "--check", str(d)],
+        2,
+        "cannot be read: it is a folder; give a file",
+    ),
     "pre-swap states at a directory": (
         lambda d: ["demo", "--task", "baoding", "--preswap_out", str(d)],
         2,

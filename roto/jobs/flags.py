@@ -23,3 +23,13 @@ def add_worker_flags(parser: argparse.ArgumentParser, job: str) -> None:
         action="store_true",
         help=f"first fail and retry every running {job} (only when no other worker is alive)",
     )
+
+
+def check_worker_flags(args: argparse.Namespace) -> None:
+    """ValueError naming the first of ``add_worker_flags``' numbers out of its range (before a study is
+    made or a worker starts)."""
+    for flag, value in (("--workers", args.workers), ("--torch_threads", args.torch_threads)):
+        if value < 1:
+            raise ValueError(f"{flag} must be an integer >= 1, got {value}")
+    if not args.heartbeat > 0:  # also refuses nan
+        raise ValueError(f"--heartbeat must be a number of seconds > 0, got {args.heartbeat}")

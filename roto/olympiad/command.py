@@ -8,7 +8,7 @@ import json
 import pathlib
 from typing import TYPE_CHECKING
 
-from roto.jobs.flags import add_worker_flags
+from roto.jobs.flags import add_worker_flags, check_worker_flags
 from roto.olympiad.submission_command import add_results_submission_flags, add_submit_parser, cmd_check
 from roto.sweep.command import STORAGE_HELP
 
@@ -106,8 +106,7 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         adopted = adopt_cells(source_plan, source_results, plan, results)
         print(json.dumps({"plan": plan.name, "adopted": adopted, "from": source_plan.name, "results": str(results)}))
         return 0
-    if args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    check_worker_flags(args)
     if args.dry_run:
         print(dry_run_report(chosen, args.root, results, args.storage, args.workers, plan if args.only else None))
         return 0

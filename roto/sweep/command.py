@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from roto.jobs.flags import add_worker_flags
+from roto.jobs.flags import add_worker_flags, check_worker_flags
 from roto.sweep.settings import sweep_defaults
 
 STORAGE_HELP = (
@@ -131,8 +131,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         raise ValueError("--study is required: the study's name (workers with the same name join one study)")
     values = {name: getattr(args, name) for name in RUN_FLAGS}
     settings = SweepSettings(study=args.study, overrides=tuple(args.overrides), **values)
-    if args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    check_worker_flags(args)
     if args.enqueue_base:  # before any worker draws a trial
         space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
         study = open_study(settings)[0]
