@@ -14,7 +14,7 @@ from typing import Any
 
 from roto.envs.aids.settings import LEGACY_FIELDS
 from roto.envs.config import EnvConfig
-from roto.rl.config_files import merge, parse_override
+from roto.rl.config_files import TRAINING_AIDS, merge, parse_override
 
 AIDS = "aids"
 
@@ -36,6 +36,11 @@ def split_overrides(items: list[str]) -> tuple[dict[str, Any], list[str]]:
     for item in items:
         key, value = parse_override(item)
         section, _, leaf = key.partition(".")
+        if section == TRAINING_AIDS:  # an agent config's section, whose aids the envs carry
+            raise ValueError(
+                f"override {item!r}: a config's {TRAINING_AIDS} are the envs' aids; "
+                f"on the command line: {'.'.join(('env', AIDS, leaf) if leaf else ('env', AIDS))}=..."
+            )
         if section != ENV_SECTION:
             agent.append(item)
             continue

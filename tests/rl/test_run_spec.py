@@ -60,6 +60,10 @@ def test_a_configs_training_aids_set_the_training_envs_per_hand_and_an_override_
         (["env.task=baoding"], "unknown env key 'task'"),
         (["env.backend=abacus"], "abacus"),
         (["ppo.nosuch=1"], "unknown config key 'ppo.nosuch'"),
+        (  # the section's name as an agent config writes it
+            ["training_aids.turn_shaping.per_turn=10"],
+            r"config's training_aids are the envs' aids; on the command line: env.aids.turn_shaping.per_turn=\.\.\.",
+        ),
     ],
 )
 def test_a_bad_spec_is_refused_before_anything_exists(overrides, message, tmp_path):
