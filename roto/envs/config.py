@@ -4,11 +4,33 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.util
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from math import inf
 
 from roto.envs.aids.settings import AidsConfig, parse_aids
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, TOUCH_MODES
 from roto.sim.backend import BACKENDS
+
+MAX_SEED = 2**63 - 1
+"""The largest seed the reset noise's generator takes (a non-negative 64-bit integer, as Gymnasium's)."""
+
+
+def _check_integer(name: str, value: object, valid: str, within: Callable[[int], bool]) -> None:
+    """ValueError naming ``name``, what is ``valid`` and ``value`` unless it is an int (not a bool) ``within``."""
+    if isinstance(value, bool) or not isinstance(value, int) or not within(value):
+        raise ValueError(f"{name} must be {valid}, got {value!r}")
+
+
+def _check_number(name: str, value: object, valid: str, within: Callable[[float], bool]) -> None:
+    """ValueError naming ``name``, what is ``valid`` and ``value`` unless it is a real number ``within``
+    (nan is never within)."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not within(value):
+        raise ValueError(f"{name} must be {valid}, got {value!r}")
+
+
+def _finite_non_negative(value: float) -> bool:
+    return 0.0 <= value < inf
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -26,7 +48,7 @@ class EnvConfig:
         backend: physics backend (``cpu``: MuJoCo C threads; ``warp``: MuJoCo Warp, see docs/backends.md).
         device: torch device of all tensors the env returns, and where ``warp`` simulates
             (``cpu`` or ``cuda[:k]``; the ``cpu`` backend needs ``cpu``).
-        seed: seed of the reset noise.
+        seed: seed of the reset noise (an integer in [0, 2**63 - 1], as Gymnasium's seeds).
         threads: C threads stepping the worlds (CPU backend).
         frame_stack: frames k stacked per observation group.
         substeps: physics steps per control step (1/240 s each).
@@ -35,8 +57,8 @@ class EnvConfig:
         touch: what the tactile group holds: ``binary`` (a touch bit per link, the benchmark's
             signal), ``force`` (log(1 + |F| / 0.1 N) of each link's net contact force) or
             ``taxels`` (the links' bits, then a bit per taxel of the fingertip pads and the palm).
-        tactile_threshold: normal force (N) above which a link or a taxel counts as touched.
-        reset_joint_noise: half-width (rad) of the uniform noise added to the default pose at reset.
+        tactile_threshold: normal force (N, >= 0) above which a link or a taxel counts as touched.
+        reset_joint_noise: half-width (rad, >= 0) of the uniform noise added to the default pose at reset.
         nconmax: contacts per world the ``warp`` backend allocates (None: roto's measured figure for
             this robot and task, ``PairRecord.warp_capacity``).
         njmax: constraint rows per world for ``warp`` (None: as for ``nconmax``).
@@ -83,16 +105,14 @@ class EnvConfig:
                 raise ValueError(f"unknown extra observation group {group!r}; valid groups: {list(OBS_GROUPS)}")
         if self.backend not in BACKENDS:
             raise ValueError(f"unknown backend {self.backend!r}; valid backends: {list(BACKENDS)}")
-        if isinstance(self.num_envs, bool) or not isinstance(self.num_envs, int) or self.num_envs < 1:
-            raise ValueError(f"num_envs must be an integer >= 1, got {self.num_envs!r}")
-        if isinstance(self.threads, bool) or not isinstance(self.threads, int) or self.threads < 1:
-            raise ValueError(f"threads must be an integer >= 1, got {self.threads!r}")
-        if self.frame_stack < 1:
-            raise ValueError(f"frame_stack must be >= 1, got {self.frame_stack!r}")
-        if self.substeps < 1 or self.episode_steps < 1:
-            raise ValueError(f"substeps and episode_steps must be >= 1, got {self.substeps}, {self.episode_steps}")
-        if not 0.0 < self.action_smoothing <= 1.0:
-            raise ValueError(f"action_smoothing must be in (0, 1], got {self.action_smoothing!r}")
+        for name in ("num_envs", "threads", "frame_stack", "substeps", "episode_steps"):
+            _check_integer(name, getattr(self, name), "an integer >= 1", lambda value: value >= 1)
+        _check_integer("seed", self.seed, "an integer in [0, 2**63 - 1]", lambda value: 0 <= value <= MAX_SEED)
+        _check_number("action_smoothing", self.action_smoothing, "a number in (0, 1]", lambda value: 0.0 < value <= 1.0)
+        _check_number("tactile_threshold", self.tactile_threshold, "a force >= 0 (N)", _finite_non_negative)
+        _check_number(
+            "reset_joint_noise", self.reset_joint_noise, "a half-width >= 0 (rad)", lambda value: 0.0 <= value < inf
+        )
         for name in ("nconmax", "njmax"):
             value = getattr(self, name)
             if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
