@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import math
 import types
 import typing
 from dataclasses import dataclass, field
@@ -162,8 +163,26 @@ class AgentConfig:
             raise ValueError(f"run.keep_checkpoints must be >= 0, got {self.run.keep_checkpoints}")
         if not (0.0 < p.gamma <= 1.0 and 0.0 <= p.lam <= 1.0):
             raise ValueError(f"ppo.gamma must be in (0, 1] and ppo.lam in [0, 1], got {p.gamma}, {p.lam}")
-        if p.lr <= 0.0:
-            raise ValueError(f"ppo.lr must be > 0, got {p.lr}")
+        for section in ("network", "ppo"):
+            for name, value in dataclasses.asdict(getattr(self, section)).items():
+                if isinstance(value, float) and not math.isfinite(value):
+                    raise ValueError(f"{section}.{name} must be a finite number, got {value}")
+        for name in ("encoder", "policy_head", "value_head"):
+            widths = getattr(self.network, name)
+            if any(width < 1 for width in widths):
+                raise ValueError(f"network.{name} must list layer widths >= 1, got {list(widths)}")
+        above_zero = {"lr": p.lr, "max_grad_norm": p.max_grad_norm, "kl_target": p.kl_target, "lr_min": p.lr_min}
+        for name, value in above_zero.items():
+            if value <= 0.0:
+                raise ValueError(f"ppo.{name} must be > 0, got {value}")
+        at_least_zero = {"ratio_clip": p.ratio_clip, "value_clip": p.value_clip, "value_coef": p.value_coef}
+        for name, value in at_least_zero.items():  # 0: the bound of roto's released search space
+            if value < 0.0:
+                raise ValueError(f"ppo.{name} must be >= 0, got {value}")
+        if p.kl_factor <= 1.0:
+            raise ValueError(f"ppo.kl_factor must be > 1 (the adaptive rate's step), got {p.kl_factor}")
+        if p.lr_min > p.lr_max:
+            raise ValueError(f"ppo.lr_min must be <= ppo.lr_max, got {p.lr_min} > {p.lr_max}")
         for name in ("actor", "critic"):
             groups = getattr(self.network, name)
             if groups is not None:

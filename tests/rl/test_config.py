@@ -30,6 +30,32 @@ def test_wrong_types_are_errors():
         from_dict(AgentConfig, {"network": {"encoder": "big"}})
 
 
+@pytest.mark.parametrize(
+    ("section", "message"),
+    [
+        ({"network": {"encoder": [256, 0]}}, r"network.encoder must list layer widths >= 1, got \[256, 0\]"),
+        ({"network": {"value_head": [-3]}}, r"network.value_head must list layer widths >= 1, got \[-3\]"),
+        ({"network": {"init_log_std": float("nan")}}, r"network.init_log_std must be a finite number, got nan"),
+        ({"ppo": {"lr": float("inf")}}, r"ppo.lr must be a finite number, got inf"),
+        ({"ppo": {"ratio_clip": -0.1}}, r"ppo.ratio_clip must be >= 0, got -0.1"),
+        ({"ppo": {"max_grad_norm": -1.0}}, r"ppo.max_grad_norm must be > 0, got -1.0"),  # would flip the gradients
+        ({"ppo": {"kl_target": 0.0}}, r"ppo.kl_target must be > 0, got 0.0"),
+        ({"ppo": {"value_coef": -1.0}}, r"ppo.value_coef must be >= 0, got -1.0"),
+        ({"ppo": {"kl_factor": 1.0}}, r"ppo.kl_factor must be > 1 \(the adaptive rate's step\), got 1.0"),
+        ({"ppo": {"lr_min": 0.1, "lr_max": 0.01}}, r"ppo.lr_min must be <= ppo.lr_max, got 0.1 > 0.01"),
+    ],
+)
+def test_values_no_run_can_use_are_refused_naming_the_key(section, message):
+    with pytest.raises(ValueError, match=message):
+        from_dict(AgentConfig, section).validate()
+
+
+def test_every_packaged_config_passes_the_checks():
+    for name in packaged_configs():
+        task = "bounce" if name.startswith("bounce") else "baoding"
+        assert load_agent_config(task, name).validate()
+
+
 def test_tuned_ssl_configs_follow_the_spec():
     fd = load_agent_config("bounce", "bounce_forward_dynamics")
     assert (fd.ppo.rollouts, fd.ppo.epochs, fd.ppo.minibatches) == (16, 10, 8)
