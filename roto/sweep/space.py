@@ -178,6 +178,16 @@ def load_space(space: str, env: EnvConfig, agent_cfg: str | None = None, overrid
         for loss, config in base.ssl.enabled().items():
             if key in {f.name for f in dataclasses.fields(config)}:
                 parameters.append(parse_parameter(f"ssl.{loss}.{key}", spec, where))
+    if not parameters:
+        ssl = (
+            " and its ssl_parameters tune none of the base config's auxiliary losses"
+            if data.get("ssl_parameters")
+            else ""
+        )
+        raise ValueError(
+            f"{where}: no parameter to search (its 'parameters' are empty{ssl}); a trial would train the base "
+            "config unchanged: name parameters as section.key: {type: float|int|categorical, ...}"
+        )
     for parameter in parameters:
         for value in parameter.extremes():
             try:

@@ -72,6 +72,9 @@ def test_suggested_values_stay_in_their_distributions_and_become_overrides():
         ("parameters:\n  ppo.lr: {type: float, low: 0.1, high: 0.2, q: 2}", r"unknown keys \['q'\]"),
         ("ssl_parameters:\n  wieght: {type: float, low: 0.1, high: 0.2}", r"unknown ssl parameter 'wieght'.*'weight'"),
         ("params:\n  ppo.lr: {type: float, low: 0.1, high: 0.2}", r"unknown sections \['params'\]"),
+        ("", r"no parameter to search \(its 'parameters' are empty\); a trial would train the base config"),
+        ("parameters: {}\nssl_parameters:\n  weight: {type: float, low: 0.1, high: 0.2}",
+         r"its ssl_parameters tune none of the base config's auxiliary losses"),
     ],
 )  # fmt: skip
 def test_a_bad_space_is_rejected_naming_the_key_and_the_valid_choices(tmp_path, text, message):
