@@ -31,6 +31,8 @@ MIN_SEEDS = 3
 NO_TOUCH = "none"
 """The touch of a ``proprio`` submission, whose agent reads no tactile group."""
 METHOD_NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,39}")
+URL = re.compile(r"https?://\S+")
+"""What a method's optional ``url`` must look like: a web address, where the method is described."""
 FIELDS = {
     FORMAT_KEY: int,
     "task": str,
@@ -94,6 +96,12 @@ def _check_method(where: str, method: dict) -> None:
         )
     if not method["description"].strip():
         raise ValueError(f"{where}: method 'description' is empty; say what the method is and what it trained with")
+    for key, valid in (("url", "a web address (http:// or https://...)"), ("commit", "a string")):
+        value = method.get(key)
+        if value is None:
+            continue
+        if not isinstance(value, str) or not value.strip() or (key == "url" and not URL.fullmatch(value)):
+            raise ValueError(f"{where}: method {key!r} should be {valid}, got {value!r}")
 
 
 def _check_evaluation(where: str, evaluation: dict) -> int:

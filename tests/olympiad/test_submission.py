@@ -74,6 +74,9 @@ BAD = [
     (lambda d: d.update(env_steps=0), "'env_steps' (the training budget per seed) should be >= 1, got 0"),
     (lambda d: d["method"].update(name="My Method"), "method 'name' 'My Method' should be 1-40 characters"),
     (lambda d: d["method"].pop("description"), "'method' lacks the field(s) ['description']"),
+    (lambda d: d["method"].update(url="github.com/me/x"), "method 'url' should be a web address (http:// or https"),
+    (lambda d: d["method"].update(url=7), "method 'url' should be a web address (http:// or https://...), got 7"),
+    (lambda d: d["method"].update(commit=""), "method 'commit' should be a string, got ''"),
     (lambda d: d["evaluation"].update(episodes=99), "'episodes' is 99; roto's protocol evaluates >= 100 episodes"),
     (lambda d: d["evaluation"].update(seed=0), "'seed' is 0; roto's protocol evaluates from seed 1000000"),
     (
