@@ -96,6 +96,16 @@ CASES = {
         2,
         "--torch_threads must be an integer >= 1, got -2",
     ),
+    "a plan's results folder that is a file": (
+        lambda d: ["olympiad", "smoke", "--root", str(d / "o"), "--results", write(d / "results", "")],
+        2,
+        "--results '",
+    ),
+    "a sweep's root that is a file": (
+        lambda d: ["sweep", "--study", "s", "--root", write(d / "sweeps", ""), "--steps", "16"],
+        2,
+        "is a file; give a directory",
+    ),
     "a page to refresh that is a folder": (
         lambda d: ["results", "--pages", str(d)],
         2,

@@ -8,6 +8,7 @@ import json
 import pathlib
 from typing import TYPE_CHECKING
 
+from roto.cli_errors import check_output_path
 from roto.jobs.flags import add_worker_flags, check_worker_flags
 from roto.olympiad.submission_command import add_results_submission_flags, add_submit_parser, cmd_check
 from roto.sweep.command import STORAGE_HELP
@@ -99,6 +100,8 @@ def cmd_olympiad(args: argparse.Namespace) -> int:
         plan = dataclasses.replace(plan, threads=args.threads)
     chosen = select_cells(plan, args.only)  # a pattern that matches no cell stops here, before anything runs
     results = _results_dir(args, plan.name)
+    check_output_path(args.root, "--root", kind="dir")  # not after hours of training, at the first summary
+    check_output_path(results, "--results", kind="dir")
     if args.adopt:
         from roto.olympiad.adopt import adopt_cells
 

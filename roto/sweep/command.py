@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 
+from roto.cli_errors import check_output_path
 from roto.jobs.flags import add_worker_flags, check_worker_flags
 from roto.sweep.settings import sweep_defaults
 
@@ -132,6 +133,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     values = {name: getattr(args, name) for name in RUN_FLAGS}
     settings = SweepSettings(study=args.study, overrides=tuple(args.overrides), **values)
     check_worker_flags(args)
+    check_output_path(args.root, "--root", kind="dir")
     if args.enqueue_base:  # before any worker draws a trial
         space = load_space(settings.space, settings.base_env(), settings.agent_cfg, settings.overrides)
         study = open_study(settings)[0]
