@@ -104,6 +104,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         run_dir = args.run_dir or pathlib.Path("runs") / (
             f"{spec.env.task}_{spec.env.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{spec.env.seed}"
         )
+        check_output_path(run_dir, "--run_dir", kind="dir")
         if (pathlib.Path(run_dir) / CONFIG_NAME).exists():
             raise ValueError(
                 f"--run_dir {str(run_dir)!r} already holds a run; continue it with --resume {str(run_dir)!r}, "

@@ -101,6 +101,11 @@ CASES = {
         2,
         "--results '",
     ),
+    "a run directory that is a file": (
+        lambda d: ["train", "--steps", "16", "--run_dir", write(d / "run", "")],
+        2,
+        "is a file; give a directory",
+    ),
     "a sweep's root that is a file": (
         lambda d: ["sweep", "--study", "s", "--root", write(d / "sweeps", ""), "--steps", "16"],
         2,
