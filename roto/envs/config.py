@@ -30,6 +30,7 @@ def _check_number(name: str, value: object, valid: str, within: Callable[[float]
 
 
 def _finite_non_negative(value: float) -> bool:
+    """Whether ``value`` is a finite number >= 0 (a force, a noise's half-width)."""
     return 0.0 <= value < inf
 
 
@@ -110,9 +111,7 @@ class EnvConfig:
         _check_integer("seed", self.seed, "an integer in [0, 2**63 - 1]", lambda value: 0 <= value <= MAX_SEED)
         _check_number("action_smoothing", self.action_smoothing, "a number in (0, 1]", lambda value: 0.0 < value <= 1.0)
         _check_number("tactile_threshold", self.tactile_threshold, "a force >= 0 (N)", _finite_non_negative)
-        _check_number(
-            "reset_joint_noise", self.reset_joint_noise, "a half-width >= 0 (rad)", lambda value: 0.0 <= value < inf
-        )
+        _check_number("reset_joint_noise", self.reset_joint_noise, "a half-width >= 0 (rad)", _finite_non_negative)
         for name in ("nconmax", "njmax"):
             value = getattr(self, name)
             if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
