@@ -36,6 +36,7 @@ except ImportError as error:  # pragma: no cover - depends on the installation
 from roto.envs.config import EnvConfig
 from roto.envs.episodes import EPISODE_NAMES
 from roto.envs.roto_env import RotoEnv
+from roto.wrappers.wrapped_env import require_roto_env
 
 _LOG_NAMES = EPISODE_NAMES
 """roto's short episode-info keys, spelled out for RSL-RL's log (other keys keep their names)."""
@@ -45,6 +46,7 @@ class RslRlVecEnv(VecEnv):
     """``env``'s B worlds as an RSL-RL ``VecEnv``; resets the env once, as RSL-RL's runner never does."""
 
     def __init__(self, env: RotoEnv) -> None:
+        env = require_roto_env(env, "RslRlVecEnv")
         self.env = env
         self.num_envs = env.num_envs
         self.num_actions = env.num_actions

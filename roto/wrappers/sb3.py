@@ -26,12 +26,14 @@ except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError("roto.wrappers.sb3 needs Stable-Baselines3: pip install -e '.[sb3]'") from error
 
 from roto.envs.roto_env import RotoEnv
+from roto.wrappers.wrapped_env import require_roto_env
 
 
 class Sb3VecEnv(VecEnv):
     """``env``'s B worlds as an SB3 ``VecEnv`` (numpy in and out, torch inside on the env's device)."""
 
     def __init__(self, env: RotoEnv) -> None:
+        env = require_roto_env(env, "Sb3VecEnv")
         self.env = env
         self._actions: torch.Tensor | None = None
         super().__init__(env.num_envs, env.observation_space, env.action_space)

@@ -46,6 +46,7 @@ except ImportError as error:  # pragma: no cover - depends on the installation
 from roto.envs.episodes import EPISODE_NAMES
 from roto.envs.observations import OBS_MODES
 from roto.envs.roto_env import RotoEnv
+from roto.wrappers.wrapped_env import require_roto_env
 
 _LOG_NAMES = {**EPISODE_NAMES, "time_out": "time-out share"}
 """roto's short episode-info keys, spelled out for skrl's log (other keys keep their names)."""
@@ -55,7 +56,7 @@ class SkrlWrapper(Wrapper):
     """``env``'s B worlds as one skrl single-agent env; groups concatenated as the module docstring says."""
 
     def __init__(self, env: RotoEnv) -> None:
-        super().__init__(env)
+        super().__init__(require_roto_env(env, "SkrlWrapper"))
         mode = OBS_MODES[env.config.obs_mode]
         self.policy_groups = tuple(group for group in env.groups if group in mode)
         extra = tuple(group for group in env.groups if group not in mode)

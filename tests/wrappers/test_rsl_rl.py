@@ -128,3 +128,10 @@ def test_staggered_episode_starts_are_a_clear_error():
     runner = OnPolicyRunner(RslRlVecEnv(_privileged_env(2)), _train_cfg(num_steps_per_env=2), device="cpu")
     with pytest.raises(AttributeError, match="init_at_random_ep_len=False"):
         runner.learn(num_learning_iterations=1, init_at_random_ep_len=True)
+
+
+def test_a_gymnasium_env_is_refused_naming_the_adapter():
+    import gymnasium
+
+    with pytest.raises(TypeError, match=r"^RslRlVecEnv wraps a batched roto env"):
+        RslRlVecEnv(gymnasium.make("roto/Bounce-Shadow-v0"))

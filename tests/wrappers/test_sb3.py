@@ -65,3 +65,10 @@ def test_sb3_env_checker_accepts_the_single_gymnasium_env():
     env = gymnasium.make("roto/Bounce-Shadow-v0")
     check_env(env.unwrapped, warn=True)
     env.close()
+
+
+def test_a_gymnasium_env_is_refused_naming_the_adapter():
+    import gymnasium
+
+    with pytest.raises(TypeError, match=r"^Sb3VecEnv wraps a batched roto env"):
+        Sb3VecEnv(gymnasium.make("roto/Bounce-Shadow-v0"))

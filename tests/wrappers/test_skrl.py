@@ -165,3 +165,10 @@ def test_skrl_ppo_trains_with_its_sequential_trainer(tmp_path):
     assert len(data["Episode / return"]) >= 2 and all(1 <= x <= 10 for x in data["Episode / length"])
     first_return = data["Episode / return"][0]
     assert first_return > 0.1 and first_return == pytest.approx(data["Reward / Total reward (mean)"][0], rel=1e-5)
+
+
+def test_a_gymnasium_env_is_refused_naming_the_adapter():
+    import gymnasium
+
+    with pytest.raises(TypeError, match=r"^SkrlWrapper wraps a batched roto env"):
+        SkrlWrapper(gymnasium.make("roto/Bounce-Shadow-v0"))
