@@ -16,6 +16,7 @@ from roto.olympiad.command import add_olympiad_parsers
 from roto.rl.config_help import HelpConfigAction
 from roto.rl.stop_requests import interrupt_on_sigterm
 from roto.sweep.command import add_sweep_parser
+from roto.value_checks import check_count
 
 
 def _cmd_list(args: argparse.Namespace) -> int:
@@ -81,8 +82,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
     from roto.rl.run_spec import DEFAULT_STEPS, build_run_spec
     from roto.rl.runner import Trainer
 
-    if isinstance(args.torch_threads, bool) or args.torch_threads < 1:
-        raise ValueError(f"--torch_threads must be an integer >= 1, got {args.torch_threads}")
+    check_count("--torch_threads", args.torch_threads, 1)
     torch.set_num_threads(args.torch_threads)
     wandb_project = args.wandb_project if args.logger == "wandb" else None
     if args.resume:

@@ -4,34 +4,16 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.util
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from math import inf
 
 from roto.envs.aids.settings import AidsConfig, parse_aids
 from roto.envs.observations import OBS_GROUPS, OBS_MODES, TOUCH_MODES
 from roto.sim.backend import BACKENDS
+from roto.value_checks import check_count, check_number
 
 MAX_SEED = 2**63 - 1
 """The largest seed the reset noise's generator takes (a non-negative 64-bit integer, as Gymnasium's)."""
-
-
-def _check_integer(name: str, value: object, valid: str, within: Callable[[int], bool]) -> None:
-    """ValueError naming ``name``, what is ``valid`` and ``value`` unless it is an int (not a bool) ``within``."""
-    if isinstance(value, bool) or not isinstance(value, int) or not within(value):
-        raise ValueError(f"{name} must be {valid}, got {value!r}")
-
-
-def _check_number(name: str, value: object, valid: str, within: Callable[[float], bool]) -> None:
-    """ValueError naming ``name``, what is ``valid`` and ``value`` unless it is a real number ``within``
-    (nan is never within)."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not within(value):
-        raise ValueError(f"{name} must be {valid}, got {value!r}")
-
-
-def _finite_non_negative(value: float) -> bool:
-    """Whether ``value`` is a finite number >= 0 (a force, a noise's half-width)."""
-    return 0.0 <= value < inf
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -107,11 +89,13 @@ class EnvConfig:
         if self.backend not in BACKENDS:
             raise ValueError(f"unknown backend {self.backend!r}; valid backends: {list(BACKENDS)}")
         for name in ("num_envs", "threads", "frame_stack", "substeps", "episode_steps"):
-            _check_integer(name, getattr(self, name), "an integer >= 1", lambda value: value >= 1)
-        _check_integer("seed", self.seed, "an integer in [0, 2**63 - 1]", lambda value: 0 <= value <= MAX_SEED)
-        _check_number("action_smoothing", self.action_smoothing, "a number in (0, 1]", lambda value: 0.0 < value <= 1.0)
-        _check_number("tactile_threshold", self.tactile_threshold, "a force >= 0 (N)", _finite_non_negative)
-        _check_number("reset_joint_noise", self.reset_joint_noise, "a half-width >= 0 (rad)", _finite_non_negative)
+            check_count(name, getattr(self, name), 1)
+        check_count("seed", self.seed, 0, MAX_SEED)
+        smoothing = self.action_smoothing
+        if isinstance(smoothing, bool) or not isinstance(smoothing, int | float) or not 0.0 < smoothing <= 1.0:
+            raise ValueError(f"action_smoothing must be a number in (0, 1], got {smoothing!r}")
+        check_number("tactile_threshold", self.tactile_threshold, 0.0, inf, "a force (N)")
+        check_number("reset_joint_noise", self.reset_joint_noise, 0.0, inf, "a half-width (rad)")
         for name in ("nconmax", "njmax"):
             value = getattr(self, name)
             if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):

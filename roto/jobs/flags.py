@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from roto.value_checks import check_count
+
 HEARTBEAT_S = 30.0
 """Seconds between a running job's heartbeats; a job silent for 4 of them is declared dead."""
 
@@ -28,8 +30,7 @@ def add_worker_flags(parser: argparse.ArgumentParser, job: str) -> None:
 def check_worker_flags(args: argparse.Namespace) -> None:
     """ValueError naming the first of ``add_worker_flags``' numbers out of its range (before a study is
     made or a worker starts)."""
-    for flag, value in (("--workers", args.workers), ("--torch_threads", args.torch_threads)):
-        if value < 1:
-            raise ValueError(f"{flag} must be an integer >= 1, got {value}")
+    check_count("--workers", args.workers, 1)
+    check_count("--torch_threads", args.torch_threads, 1)
     if not args.heartbeat > 0:  # also refuses nan
         raise ValueError(f"--heartbeat must be a number of seconds > 0, got {args.heartbeat}")

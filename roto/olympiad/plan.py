@@ -42,6 +42,7 @@ from roto.rl.run_spec import build_run_spec
 from roto.robots import ROBOTS
 from roto.sim.backend import BACKENDS
 from roto.tasks import TASKS
+from roto.value_checks import check_count
 from roto.yaml_files import read_yaml
 
 PLAN_KEYS = {"description", "steps", "eval_episodes", "num_envs", "threads", "backend", "device", "variants", "grids"}
@@ -169,8 +170,7 @@ def load_plan(plan: str) -> Plan:
         for key, default in (("steps", 5_000_000), ("eval_episodes", 100), ("num_envs", 128), ("threads", 1))
     }
     for key, value in numbers.items():
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise ValueError(f"{where}: {key} must be an integer >= 1, got {value!r}")
+        check_count(f"{where}: {key}", value, 1)
     variants = {
         name: _variant(name, spec, f"{where}: variant {name!r}") for name, spec in (data.get("variants") or {}).items()
     }
@@ -250,8 +250,8 @@ def _grid_cells(grid: Any, variants: dict[str, Variant], where: str) -> tuple[li
     """The grid's cells and its own ``steps`` (None: the plan's)."""
     _check_keys(grid, GRID_KEYS | {"steps"}, where)
     steps = grid.get("steps")
-    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, int) or steps < 1):
-        raise ValueError(f"{where}: steps must be an integer >= 1, got {steps!r}")
+    if steps is not None:
+        check_count(f"{where}: steps", steps, 1)
     valid = {"tasks": sorted(TASKS), "robots": sorted(ROBOTS), "obs": list(OBS_MODES), "variants": sorted(variants)}
     for key in GRID_KEYS:
         values = grid.get(key)

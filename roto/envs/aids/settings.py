@@ -17,23 +17,12 @@ meaning is on its class; what each aid does is in its module (``roto.envs.aids.<
 from __future__ import annotations
 
 import dataclasses
-import math
 import typing
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-
-def _number(path: str, value: object, low: float, high: float, what: str) -> None:
-    """Raise ValueError unless ``value`` is a real number in [low, high]."""
-    ok = not isinstance(value, bool) and isinstance(value, int | float) and math.isfinite(value)
-    if not ok or not low <= value <= high:
-        raise ValueError(f"{path} must be {what} in [{low:g}, {high:g}], got {value!r}")
-
-
-def _count(path: str, value: object, low: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < low:
-        raise ValueError(f"{path} must be an integer >= {low}, got {value!r}")
+from roto.value_checks import check_count, check_number
 
 
 def _needs_parameter(path: str, task: Any, parameter: str, what: str, tasks: str = "baoding") -> None:
@@ -63,9 +52,9 @@ class ReplayedStartsSettings:
     def check(self, path: str, task: Any) -> None:
         if not isinstance(self.bank, str) or not self.bank:
             raise ValueError(f"{path}.bank must name an .npz of recorded states, got {self.bank!r}")
-        _number(f"{path}.share", self.share, 0.0, 1.0, "a share")
-        _count(f"{path}.record_lead", self.record_lead, 0)
-        _count(f"{path}.record_capacity", self.record_capacity, 1)
+        check_number(f"{path}.share", self.share, 0.0, 1.0, "a share")
+        check_count(f"{path}.record_lead", self.record_lead, 0)
+        check_count(f"{path}.record_capacity", self.record_capacity, 1)
         if self.record_lead > 0 and self.share == 0.0:
             raise ValueError(
                 f"{path}.record_lead {self.record_lead} records states for replayed starts, but {path}.share is 0 "
@@ -102,14 +91,14 @@ class ToleranceSettings:
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "success_radius", "a success radius")
         own = task.parameters["success_radius"]
-        _number(f"{path}.start", self.start, own, 1.0, f"a radius (m) no smaller than the task's own {own}")
+        check_number(f"{path}.start", self.start, own, 1.0, f"a radius (m) no smaller than the task's own {own}")
         if self.by not in TOLERANCE_MEASURES:
             raise ValueError(f"{path}.by must be one of {list(TOLERANCE_MEASURES)}, got {self.by!r}")
-        _number(f"{path}.target", self.target, 1e-9, 1e6, f"a mean of {self.by} per episode")
+        check_number(f"{path}.target", self.target, 1e-9, 1e6, f"a mean of {self.by} per episode")
         if self.by == "net_turns":
             _needs_parameter(f"{path}.by", task, "turn_reward", "a ball pair")
         if self.deadline is not None:
-            _count(f"{path}.deadline", self.deadline, 1)
+            check_count(f"{path}.deadline", self.deadline, 1)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -135,11 +124,11 @@ class RoundSwapsSettings:
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "swap_min_turn", "swaps")
-        _number(f"{path}.min_turn", self.min_turn, 0.0, 0.5, "a number of turns")
+        check_number(f"{path}.min_turn", self.min_turn, 0.0, 0.5, "a number of turns")
         if not isinstance(self.first_paid, bool):
             raise ValueError(f"{path}.first_paid must be true or false, got {self.first_paid!r}")
         if self.after is not None:
-            _number(f"{path}.after", self.after, 1e-9, 1e6, "rotations per episode (or null: from the start)")
+            check_number(f"{path}.after", self.after, 1e-9, 1e6, "rotations per episode (or null: from the start)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -179,22 +168,24 @@ class TurnShapingSettings:
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "turn_reward", "a ball pair")
-        _number(f"{path}.per_turn", self.per_turn, 0.0, 1000.0, "a reward per turn")
+        check_number(f"{path}.per_turn", self.per_turn, 0.0, 1000.0, "a reward per turn")
         if self.lead is not None:
-            _number(f"{path}.lead", self.lead, 0.0, 100.0, "a number of turns (or null: unbounded)")
+            check_number(f"{path}.lead", self.lead, 0.0, 100.0, "a number of turns (or null: unbounded)")
         if self.near is not None:
-            _number(f"{path}.near", self.near, 0.0, 100.0, "a number of half target separations (or null: anywhere)")
+            check_number(
+                f"{path}.near", self.near, 0.0, 100.0, "a number of half target separations (or null: anywhere)"
+            )
         if not isinstance(self.soft, bool):
             raise ValueError(f"{path}.soft must be true or false, got {self.soft!r}")
         if self.soft and self.near is None:
             raise ValueError(
                 f"{path}.soft needs {path}.near (the half target separations it falls off beyond), got near=None"
             )
-        _number(f"{path}.near_turns", self.near_turns, 1e-9, 1e6, "net turns per episode")
+        check_number(f"{path}.near_turns", self.near_turns, 1e-9, 1e6, "net turns per episode")
         if self.near_from is not None:
             if self.near is None:
                 raise ValueError(f"{path}.near_from needs {path}.near (the value it narrows to), got near=None")
-            _number(f"{path}.near_from", self.near_from, self.near, 100.0, "half target separations from near")
+            check_number(f"{path}.near_from", self.near_from, self.near, 100.0, "half target separations from near")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -211,7 +202,7 @@ class DropPenaltySettings:
 
     def check(self, path: str, task: Any) -> None:
         _needs_parameter(path, task, "drop_penalty", "a ball to lose", "bounce")
-        _number(f"{path}.per_drop", self.per_drop, 0.0, 1000.0, "a reward charged per lost ball")
+        check_number(f"{path}.per_drop", self.per_drop, 0.0, 1000.0, "a reward charged per lost ball")
 
 
 @dataclass(frozen=True, kw_only=True)
