@@ -2,9 +2,10 @@
 
 Shared by ``roto sweep`` (a trial is a set of parameters) and ``roto olympiad`` (a trial is a
 cell of the plan). A ``optuna.TrialPruned`` from the work ends the trial pruned with its message
-as the reason; a trial another worker has meanwhile declared dead (its report refused) is left to
-its retry, which continues the run; any other exception, Ctrl-C and SIGTERM included, fails it and enqueues a
-retry, then goes on up. ``launch_workers`` starts worker processes of a ``roto`` subcommand here.
+as the reason; a trial another worker has meanwhile declared dead (its report or its outcome
+refused) is left to its retry, which continues the run or finds its result; any other exception,
+Ctrl-C and SIGTERM included, fails it and enqueues a retry, then goes on up. ``launch_workers``
+starts worker processes of a ``roto`` subcommand here.
 """
 
 from __future__ import annotations
@@ -53,8 +54,15 @@ def run_claimed(
     try:
         if reason:
             trial.set_user_attr(REASON_ATTR, reason)
-        study.tell(trial, value, state=state)
+        told = study.tell(trial, value, state=state, skip_if_finished=True)
     except UpdateFinishedTrialError:
+        told = storage.get_trial(trial_id)
+    if told.state != state:  # failed by another worker while the work ran (--reclaim-now there, or a silence)
+        print(
+            f"trial {trial.number}: its work ended here, but another worker had already ended the trial "
+            f"({told.state.name.lower()}) and enqueued its retry, which counts instead",
+            flush=True,
+        )
         return False
     shown = f"{value:.3f}" if value is not None else reason
     print(f"trial {trial.number}: {state.name.lower()}, {shown} ({time.perf_counter() - start:.0f} s)", flush=True)
