@@ -608,6 +608,31 @@ def test_the_every_hand_hold_study_trains_exactly_the_benchmarks_blind_baoding_c
         assert cell_spec(plan, cell).differences(cell_spec(benchmark, shared[cell.name])) == {}
 
 
+def test_the_without_round_swaps_study_trains_every_baoding_cell_of_the_benchmark_with_only_round_swaps_off():
+    """experiments/baoding_without_round_swaps holds each of the benchmark's Baoding cells (same names,
+    budgets and seeds), each differing from it in the round swaps alone, so its summaries count there
+    once baoding_cpu drops them; the ablation's hold_no_round_swaps runs are exactly its cells."""
+    from roto.olympiad.adopt import same_run
+    from roto.olympiad.cell import cell_spec
+
+    plan, benchmark = plan_named("without_round_swaps"), load_plan("benchmark")
+    theirs = {c.name: c for c in benchmark.cells if c.task == "baoding"}
+    assert sorted(c.name for c in plan.cells) == sorted(theirs) and len(plan.cells) == 44
+    assert [c.seed for c in plan.cells] == sorted(c.seed for c in plan.cells)
+    for cell in plan.cells:
+        mine, benchmarks = cell_spec(plan, cell), cell_spec(benchmark, theirs[cell.name])
+        assert mine.steps == benchmarks.steps
+        assert set(mine.differences(benchmarks)) == {"env.aids.round_swaps"}
+        assert mine.env.aids.round_swaps is None and benchmarks.env.aids.round_swaps is not None
+    ablations = plan_named("ablations_hold")
+    adopted = {
+        same_run(ablations, cell, plan).name
+        for cell in ablations.cells
+        if cell.variant == "hold_no_round_swaps" and same_run(ablations, cell, plan) is not None
+    }
+    assert adopted == {f"baoding-shadow-blind-ppo-seed{s}" for s in range(5)} | {"baoding-orca-blind-ppo-seed0"}
+
+
 def assert_continues_at_20_m(longer_name: str, study_name: str) -> list:
     """Plan ``longer_name``'s cells are plan ``study_name``'s of the same names but for their budget
     (20 M against 10 M), so a run directory copied over from there continues (Trainer.open); its cells."""
