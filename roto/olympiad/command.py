@@ -288,7 +288,14 @@ def cmd_results(args: argparse.Namespace) -> int:
         raise ValueError("roto results needs SOURCE (a plan or a folder of summaries) and --out FOLDER")
     source = pathlib.Path(args.source)
     plan_source = args.plan if source.is_dir() else args.source
-    plan = load_plan(plan_source) if plan_source else None
+    try:
+        plan = load_plan(plan_source) if plan_source else None
+    except FileNotFoundError as error:
+        if plan_source is args.plan:
+            raise
+        raise FileNotFoundError(
+            f"SOURCE {args.source!r} is neither a folder of cell summaries nor a plan ({error})"
+        ) from None
     folder = source if source.is_dir() else pathlib.Path(args.root) / plan.name / "results"
     print(json.dumps(write_results(folder, args.out, plan=plan, submissions=args.submissions)))
     return 0

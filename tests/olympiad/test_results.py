@@ -102,6 +102,24 @@ def test_results_of_a_folder_without_summaries_is_a_clear_error(tmp_path, capsys
     assert "no cell summaries" in capsys.readouterr().err
 
 
+def test_results_of_a_source_that_is_neither_a_folder_nor_a_plan_says_both(tmp_path, capsys):
+    missing = tmp_path / "sumaries"  # a mistyped folder reads as a plan name
+    assert main(["results", str(missing), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"SOURCE '{missing}' is neither a folder of cell summaries nor a plan" in err and "'benchmark'" in err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(("where", "said"), [("missing", "does not exist"), ("a_file.json", "is a file")])
+def test_adopting_from_a_missing_folder_or_a_file_names_it_and_writes_nothing(tmp_path, capsys, where, said):
+    (tmp_path / "a_file.json").write_text("{}")
+    results = tmp_path / "results"
+    argv = ["olympiad", "smoke", "--results", str(results), "--adopt", "smoke", str(tmp_path / where)]
+    assert main(argv) == 2
+    assert f"the folder of cell summaries '{tmp_path / where}' {said}" in capsys.readouterr().err
+    assert not results.exists()
+
+
 def test_summaries_of_an_older_or_unrecorded_task_version_get_no_reference_column(tmp_path):
     from roto.olympiad.results_page import write_results
 
