@@ -257,9 +257,24 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
 
 def _add_eval_parser(sub: argparse._SubParsersAction) -> None:
     p_eval = sub.add_parser("eval", help="evaluate a checkpoint over full episodes (deterministic policy)")
-    p_eval.add_argument("--checkpoint", required=True)
-    p_eval.add_argument("--episodes", type=int, default=EVAL_EPISODES)
-    p_eval.add_argument("--seed", type=int, default=EVAL_SEED)
+    p_eval.add_argument(
+        "--checkpoint",
+        required=True,
+        help="a checkpoint roto train wrote (<run_dir>/checkpoints/best.pt); its task, hand, obs mode and "
+        "config come with it",
+    )
+    p_eval.add_argument(
+        "--episodes",
+        type=int,
+        default=EVAL_EPISODES,
+        help=f"full episodes, one per env (default: {EVAL_EPISODES}, the benchmark's)",
+    )
+    p_eval.add_argument(
+        "--seed",
+        type=int,
+        default=EVAL_SEED,
+        help=f"seed of the first batch of starts (default: {EVAL_SEED}, the benchmark's, apart from training seeds)",
+    )
     p_eval.add_argument(
         "--out", default=None, help="JSON path (default: next to the checkpoint; missing folders are created)"
     )
@@ -268,12 +283,24 @@ def _add_eval_parser(sub: argparse._SubParsersAction) -> None:
 
 def _add_play_parser(sub: argparse._SubParsersAction) -> None:
     p_play = sub.add_parser("play", help="render a checkpoint's policy offscreen into an mp4")
-    p_play.add_argument("--checkpoint", required=True)
+    p_play.add_argument(
+        "--checkpoint",
+        required=True,
+        help="a checkpoint roto train wrote (<run_dir>/checkpoints/best.pt); its task, hand, obs mode and "
+        "config come with it",
+    )
     p_play.add_argument(
         "--video", default="videos/play.mp4", help="mp4 path (default: videos/play.mp4; missing folders are created)"
     )
-    p_play.add_argument("--video_length", "--video-length", dest="video_length", type=int, default=600)
-    p_play.add_argument("--seed", type=int, default=0)
+    p_play.add_argument(
+        "--video_length",
+        "--video-length",
+        dest="video_length",
+        type=int,
+        default=600,
+        help="control steps to record (default: 600, one 10 s episode)",
+    )
+    p_play.add_argument("--seed", type=int, default=0, help="seed of the episode's start (default: 0)")
     p_play.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; always headless")
     p_play.set_defaults(func=_cmd_play)
 
