@@ -233,7 +233,13 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
         default=1,
         help="torch CPU threads for the PPO update; rollouts always use one (default 1)",
     )
-    p_train.add_argument("--no_progress", "--no-progress", dest="no_progress", action="store_true")
+    p_train.add_argument(
+        "--no_progress",
+        "--no-progress",
+        dest="no_progress",
+        action="store_true",
+        help="no progress bar (for logs; scalars and evaluations still go to the run directory)",
+    )
     p_train.add_argument("--help-config", "--help_config", action=HelpConfigAction)
     p_train.add_argument(
         "--logger",

@@ -8,9 +8,21 @@ import argparse
 def add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
     """The env flags shared by the commands that build envs (task, robot, worlds, seed, backend)."""
     parser.add_argument("--task", default="bounce", help="task name: bounce, baoding (default: bounce)")
-    parser.add_argument("--robot", default="shadow", help="robot name (default: shadow)")
-    parser.add_argument("--num_envs", "--num-envs", dest="num_envs", type=int, default=num_envs)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--robot", default="shadow", help="hand: shadow, shadow_lite, allegro, orca (default: shadow)")
+    parser.add_argument(
+        "--num_envs",
+        "--num-envs",
+        dest="num_envs",
+        type=int,
+        default=num_envs,
+        help=f"worlds stepped side by side (default: {num_envs})",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="random seed of the envs' starts (roto train: and of the agent) (default: 0)",
+    )
     parser.add_argument("--threads", type=int, default=1, help="C threads stepping the worlds (CPU backend)")
     parser.add_argument("--backend", default="cpu", help="physics backend: cpu (default) or warp (MuJoCo Warp)")
     parser.add_argument("--device", default="cpu", help="cpu (default), or cuda[:k] with --backend warp")

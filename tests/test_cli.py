@@ -62,3 +62,20 @@ def test_baoding_demo_passes_the_turn_weight_to_the_planner(capsys, monkeypatch)
     assert seen["robot"] == "orca" and seen["weights"].turn == 3.0 and seen["weights"].distance == 10.0
     assert main(["demo", "--task", "baoding"]) == 0
     assert seen["weights"].turn == 0.0  # off unless asked: the published figures' cost
+
+
+def test_the_env_flags_help_names_every_task_and_hand_roto_has(capsys):
+    """The help's lists are written out (the CLI imports no hand models to print its help): they
+    must name what the registries hold."""
+    import argparse
+
+    from roto.cli_args import add_env_args
+    from roto.robots import ROBOTS
+    from roto.tasks import TASKS
+
+    parser = argparse.ArgumentParser()
+    add_env_args(parser, num_envs=8)
+    text = " ".join(parser.format_help().split())  # unwrapped
+    assert f"--robot ROBOT hand: {', '.join(ROBOTS)} (default: shadow)" in text
+    assert f"--task TASK task name: {', '.join(TASKS)} (default: bounce)" in text
+    assert "worlds stepped side by side (default: 8)" in text
