@@ -8,7 +8,7 @@ import json
 import sys
 from collections.abc import Sequence
 
-from roto.cli_args import add_env_args, add_touch_arg, options_given
+from roto.cli_args import add_checkpoint_arg, add_env_args, add_touch_arg, options_given
 from roto.cli_demo import add_demo_parser
 from roto.cli_errors import check_output_path, error_exit, make_parents, quiet_on_closed_stdout
 from roto.eval.protocol import EVAL_EPISODES, EVAL_SEED
@@ -263,12 +263,7 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
 
 def _add_eval_parser(sub: argparse._SubParsersAction) -> None:
     p_eval = sub.add_parser("eval", help="evaluate a checkpoint over full episodes (deterministic policy)")
-    p_eval.add_argument(
-        "--checkpoint",
-        required=True,
-        help="a checkpoint roto train wrote (<run_dir>/checkpoints/best.pt); its task, hand, obs mode and "
-        "config come with it",
-    )
+    add_checkpoint_arg(p_eval)
     p_eval.add_argument(
         "--episodes",
         type=int,
@@ -289,12 +284,7 @@ def _add_eval_parser(sub: argparse._SubParsersAction) -> None:
 
 def _add_play_parser(sub: argparse._SubParsersAction) -> None:
     p_play = sub.add_parser("play", help="render a checkpoint's policy offscreen into an mp4")
-    p_play.add_argument(
-        "--checkpoint",
-        required=True,
-        help="a checkpoint roto train wrote (<run_dir>/checkpoints/best.pt); its task, hand, obs mode and "
-        "config come with it",
-    )
+    add_checkpoint_arg(p_play)
     p_play.add_argument(
         "--video", default="videos/play.mp4", help="mp4 path (default: videos/play.mp4; missing folders are created)"
     )

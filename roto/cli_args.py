@@ -29,6 +29,16 @@ def add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
     parser.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; no effect")
 
 
+def add_checkpoint_arg(parser: argparse.ArgumentParser) -> None:
+    """``--checkpoint``, required, of the commands that load a trained policy (eval, play)."""
+    parser.add_argument(
+        "--checkpoint",
+        required=True,
+        help="a checkpoint roto train wrote (<run_dir>/checkpoints/best.pt); its task, hand, obs mode and "
+        "config come with it",
+    )
+
+
 def add_touch_arg(parser: argparse.ArgumentParser) -> None:
     """``--touch``: the tactile signal of the envs a command builds."""
     parser.add_argument(
