@@ -21,7 +21,7 @@ def add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
         "--seed",
         type=int,
         default=0,
-        help="random seed of the envs' starts (roto train: and of the agent) (default: 0)",
+        help="seed of the envs' starts, and in roto train of the agent's weights too (default: 0)",
     )
     parser.add_argument("--threads", type=int, default=1, help="C threads stepping the worlds (CPU backend)")
     parser.add_argument("--backend", default="cpu", help="physics backend: cpu (default) or warp (MuJoCo Warp)")
