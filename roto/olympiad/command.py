@@ -286,16 +286,16 @@ def cmd_results(args: argparse.Namespace) -> int:
         return cmd_pages(args.pages)
     if args.source is None or args.out is None:
         raise ValueError("roto results needs SOURCE (a plan or a folder of summaries) and --out FOLDER")
-    source = pathlib.Path(args.source)
-    plan_source = args.plan if source.is_dir() else args.source
-    try:
-        plan = load_plan(plan_source) if plan_source else None
-    except FileNotFoundError as error:
-        if plan_source is args.plan:
-            raise
-        raise FileNotFoundError(
-            f"SOURCE {args.source!r} is neither a folder of cell summaries nor a plan ({error})"
-        ) from None
-    folder = source if source.is_dir() else pathlib.Path(args.root) / plan.name / "results"
+    folder = pathlib.Path(args.source)
+    if folder.is_dir():
+        plan = load_plan(args.plan) if args.plan else None
+    else:  # a plan, whose default results folder is read
+        try:
+            plan = load_plan(args.source)
+        except FileNotFoundError as error:
+            raise FileNotFoundError(
+                f"SOURCE {args.source!r} is neither a folder of cell summaries nor a plan ({error})"
+            ) from None
+        folder = pathlib.Path(args.root) / plan.name / "results"
     print(json.dumps(write_results(folder, args.out, plan=plan, submissions=args.submissions)))
     return 0

@@ -86,12 +86,13 @@ def variant_agents(summaries: list[dict], plan: str = "") -> Agents:
 
 def read_summaries(folder: str | pathlib.Path) -> list[dict]:
     """Every cell summary (``<cell>.json``) in ``folder``, each checked (``check_summary``)."""
-    if not pathlib.Path(folder).is_dir():
-        what = "is a file" if pathlib.Path(folder).exists() else "does not exist"
+    folder = pathlib.Path(folder)
+    if not folder.is_dir():
+        what = "is a file" if folder.exists() else "does not exist"
         raise FileNotFoundError(
             f"the folder of cell summaries {str(folder)!r} {what}; give the folder a plan's --results wrote"
         )
-    paths = sorted(pathlib.Path(folder).glob("*-seed*.json"))
+    paths = sorted(folder.glob("*-seed*.json"))
     if not paths:
         raise FileNotFoundError(f"no cell summaries (<task>-<robot>-<obs>-<variant>-seed<k>.json) in {str(folder)!r}")
     return [check_summary(path, read_json(path, "cell summary")) for path in paths]

@@ -96,12 +96,11 @@ def _check_method(where: str, method: dict) -> None:
         )
     if not method["description"].strip():
         raise ValueError(f"{where}: method 'description' is empty; say what the method is and what it trained with")
-    for key, valid in (("url", "a web address (http:// or https://...)"), ("commit", "a string")):
-        value = method.get(key)
-        if value is None:
-            continue
-        if not isinstance(value, str) or not value.strip() or (key == "url" and not URL.fullmatch(value)):
-            raise ValueError(f"{where}: method {key!r} should be {valid}, got {value!r}")
+    url, commit = method.get("url"), method.get("commit")
+    if url is not None and not (isinstance(url, str) and URL.fullmatch(url)):
+        raise ValueError(f"{where}: method 'url' should be a web address (http:// or https://...), got {url!r}")
+    if commit is not None and not (isinstance(commit, str) and commit.strip()):
+        raise ValueError(f"{where}: method 'commit' should be a string, got {commit!r}")
 
 
 def _check_evaluation(where: str, evaluation: dict) -> int:
