@@ -4,7 +4,9 @@ another (the benchmark) counts as that cell, so that no seed is trained twice.
 "Exactly" is the run spec (the one the summary records it trained; for a summary written before
 summaries recorded it, the source plan's ``cell_spec``): task, hand, obs mode, agent config and
 overrides, training aids, seed, env count and backend, compared setting by setting, and the
-env-step budget (the C threads may differ: they step the same worlds to the same states). The summary is
+env-step budget (the C threads may differ: they step the same worlds to the same states; round swaps
+that never armed count as the target's where its would not have armed either,
+``roto.olympiad.never_armed``). The summary is
 copied under the other plan's cell name with its ``variant``, ``plan`` and ``agent`` as that plan
 would have written them, and ``adopted_from`` naming the plan, cell and agent it was trained as;
 everything it measured is kept as it is.
@@ -16,6 +18,7 @@ import json
 import pathlib
 
 from roto.olympiad.cell import agent_record, cell_spec, summary_path
+from roto.olympiad.never_armed import spec_as_compared
 from roto.olympiad.plan import Cell, Plan
 from roto.olympiad.results import read_summaries
 from roto.olympiad.staleness import recorded_spec
@@ -23,17 +26,21 @@ from roto.result_files import write_text_atomic
 from roto.rl.run_spec import RunSpec
 
 
-def same_run(source_plan: Plan, source: Cell, target_plan: Plan, trained: RunSpec | None = None) -> Cell | None:
+def same_run(
+    source_plan: Plan, source: Cell, target_plan: Plan, trained: RunSpec | None = None, summary: dict | None = None
+) -> Cell | None:
     """The cell of ``target_plan`` that trains exactly what ``source`` trains in ``source_plan``, or
     None. Only cells of the same task, hand, obs mode and seed are compared (their specs, built and
     checked; a difference of any setting or of the budget is no match). ``trained``: the spec the
-    source's summary records it trained (None for a summary without one: the source plan's now)."""
+    source's summary records it trained (None for a summary without one: the source plan's now);
+    ``summary``: the source's summary, whose training record tells whether its round swaps armed."""
     spec = trained or cell_spec(source_plan, source)
     for cell in target_plan.cells:
         if (cell.task, cell.robot, cell.obs, cell.seed) != (source.task, source.robot, source.obs, source.seed):
             continue
-        same_budget = target_plan.steps_for(cell) == spec.steps
-        if same_budget and cell_spec(target_plan, cell).differences(spec) == {}:
+        now = cell_spec(target_plan, cell)
+        compared = spec if summary is None else spec_as_compared(spec, now, summary)
+        if target_plan.steps_for(cell) == spec.steps and compared.differences(now) == {}:
             return cell
     return None
 
@@ -61,7 +68,7 @@ def adopt_cells(
                 f"summary {source.name} in {str(source_results)!r}: plan {source_plan.name!r} has no variant "
                 f"{source.variant!r}; valid variants: {sorted(source_plan.variants)}"
             )
-        target = same_run(source_plan, source, target_plan, recorded_spec(summary, source.name))
+        target = same_run(source_plan, source, target_plan, recorded_spec(summary, source.name), summary)
         if target is not None and not summary_path(target_results, target).is_file():
             adoptions.append((target, adopted_summary(summary, source_plan, source, target_plan, target)))
     if adoptions:

@@ -24,6 +24,7 @@ import numpy as np
 
 from roto.envs.observations import OBS_MODES
 from roto.olympiad.cell import cell_spec
+from roto.olympiad.never_armed import aid_labels
 from roto.olympiad.path_results import kind_counts, measure_scores, seed_measures, seed_path_kind, with_derived_means
 from roto.olympiad.plan import Cell, Plan, load_plan
 from roto.olympiad.results import cell_statistics, lead_measure, read_summaries
@@ -64,7 +65,8 @@ def config_label(summary: dict, plan: Plan | None = None) -> str:
 
 def training_aids(summary: dict, plan: Plan | None = None) -> str:
     """The training aids a cell's run trained with: as its summary records them, else as ``plan``
-    trains the cell, else "not recorded"; "none" when it used none."""
+    trains the cell, else "not recorded"; "none" when it used none; round swaps that never armed
+    (``roto.olympiad.never_armed``) named so."""
     if "training_aids" in summary:
         names = sorted(summary["training_aids"])
     elif plan is not None and summary["variant"] in plan.variants:
@@ -72,7 +74,7 @@ def training_aids(summary: dict, plan: Plan | None = None) -> str:
         names = sorted(cell_spec(plan, cell).env.aids.active())
     else:
         return "not recorded"
-    return ", ".join(names) or "none"
+    return ", ".join(aid_labels(names, summary)) or "none"
 
 
 def _statistics(scores: np.ndarray | None) -> tuple[str, str, str]:

@@ -6,7 +6,9 @@ stand in the table for a run the plan no longer describes. Each summary records 
 trained (``spec``; a summary written before that records its training aids, ``training_aids``),
 so the plan check can compare it, setting by setting, with what the plan trains the cell with now
 (``roto.rl.run_spec.RunSpec.differences``: the budget and the C threads aside, since a finished
-run may be continued to a longer budget and on other threads).
+run may be continued to a longer budget and on other threads). Round swaps that never armed are no
+difference where the plan's would not have armed either (``roto.olympiad.never_armed``): the runs
+are the same.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from typing import Any
 
 from roto.envs.aids.settings import parse_aids
 from roto.olympiad.cell import cell_spec, summary_path
+from roto.olympiad.never_armed import aids_as_compared, spec_as_compared
 from roto.olympiad.plan import Cell, Plan
 from roto.result_files import read_json
 from roto.rl.run_spec import RunSpec
@@ -28,17 +31,18 @@ def summary_differences(
     plan: Plan, cell: Cell, summary: dict[str, Any], where: str = "(given)"
 ) -> dict[str, tuple[Any, Any]]:
     """{setting: (the summary's value, the plan's)} where the summary's run trained otherwise than
-    ``plan`` trains ``cell`` now: every setting of the recorded ``spec``, or of a summary without
-    one the training aids it records (``env.aids``); {} where it matches as far as it records.
-    ValueError naming ``where`` (the summary) where its spec or aids do not read."""
+        ``plan`` trains ``cell`` now: every setting of the recorded ``spec``, or of a summary without
+        one the training aids it records (``env.aids``); {} where it matches as far as it records (round
+    swaps that never armed as ``roto.olympiad.never_armed.aids_as_compared`` compares them).
+        ValueError naming ``where`` (the summary) where its spec or aids do not read."""
     now = cell_spec(plan, cell)
     trained = recorded_spec(summary, where)
     if trained is not None:
-        return trained.differences(now)
+        return spec_as_compared(trained, now, summary).differences(now)
     if "training_aids" not in summary:
         return {}
     try:
-        aids = parse_aids(summary["training_aids"])
+        aids = aids_as_compared(parse_aids(summary["training_aids"]), now.env.aids, summary)
     except ValueError as error:
         raise ValueError(f"cell summary {where}: its recorded training aids do not read ({error})") from None
     return {} if aids == now.env.aids else {"env.aids": (summary["training_aids"], now.env.aids.to_dict())}
