@@ -30,11 +30,15 @@ def never_armed(summary: Mapping[str, Any]) -> bool:
     """True where ``summary``'s training record shows armed round swaps unarmed up to its run's
     last env step: every record has ``ARMED_METRIC`` at 0, and the last is at or past the summary's
     ``env_steps``. False where the run had no armed round swaps (no flag), they armed, or the record
-    stops short of the run's end (they may have armed after it)."""
-    records = summary.get("training") or []
-    if not records or any(record.get(ARMED_METRIC) != 0 for record in records):
+    stops short of the run's end (they may have armed after it), or any of these does not read as
+    a list of records and numbers."""
+    records, steps = summary.get("training"), summary.get("env_steps")
+    if not isinstance(records, list) or not records or not all(isinstance(r, dict) for r in records):
         return False
-    return records[-1].get("env_steps", -1) >= summary.get("env_steps", float("inf"))
+    if any(record.get(ARMED_METRIC) != 0 for record in records):
+        return False
+    last = records[-1].get("env_steps")
+    return all(isinstance(v, int) and not isinstance(v, bool) for v in (last, steps)) and last >= steps
 
 
 def no_sooner(trained: AidsConfig, now: AidsConfig) -> bool:

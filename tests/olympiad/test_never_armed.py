@@ -57,6 +57,8 @@ def test_never_armed_needs_the_flag_at_zero_up_to_the_runs_last_env_step():
     unflagged = [{k: v for k, v in record.items() if k != ARMED_METRIC} for record in summary["training"]]
     assert not never_armed({**summary, "training": unflagged})  # no armed round swaps: nothing to say
     assert not never_armed({**summary, "training": []})
+    for unreadable in ({"training": {"a": 1}}, {"training": ["a"]}, {"env_steps": "all"}, {"env_steps": None}):
+        assert not never_armed({**summary, **unreadable}), unreadable
 
 
 @pytest.mark.parametrize("recorded", ["spec", "training_aids"])
