@@ -253,10 +253,10 @@ def time_left_estimate(
 
 
 def cmd_pages(pages: list[str]) -> int:
-    """Rewrite each page's generated tables (``roto.olympiad.reference_tables.refresh_blocks``;
+    """Rewrite each page's generated tables (``roto.olympiad.page_blocks.refresh_blocks``;
     sources relative to the current directory, the repository's root); nothing is written unless
     every page reads, holds generated blocks that all read, and every table can be made."""
-    from roto.olympiad.reference_tables import check_blocks, refresh_blocks
+    from roto.olympiad.page_blocks import check_blocks, refresh_blocks
     from roto.result_files import write_text_atomic
     from roto.text_files import read_text
 

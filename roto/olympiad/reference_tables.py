@@ -8,17 +8,10 @@ roto's published figures on the Shadow. ``overview_table``: the README's few lin
 (blind − proprio) with their intervals, and whether state ≥ blind ≥ proprio holds.
 ``seeds_table``: Baoding's seeds one by one. ``variants_table``: each variant beside a baseline
 variant on the seeds both trained (a study's ablations or candidates).
-``refresh_blocks`` rewrites the generated blocks of a markdown page (between
-``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN[,PLAN...]] [baseline=VARIANT] -->`` and
-``<!-- /roto results -->``) from their folders.
+A page's generated blocks of these tables: ``roto.olympiad.page_blocks``.
 """
 
 from __future__ import annotations
-
-import dataclasses
-import pathlib
-import re
-from collections.abc import Callable
 
 import numpy as np
 
@@ -26,8 +19,8 @@ from roto.envs.observations import OBS_MODES
 from roto.olympiad.cell import cell_spec
 from roto.olympiad.never_armed import aid_labels
 from roto.olympiad.path_results import kind_counts, measure_scores, seed_measures, seed_path_kind, with_derived_means
-from roto.olympiad.plan import Cell, Plan, load_plan
-from roto.olympiad.results import cell_statistics, lead_measure, read_summaries
+from roto.olympiad.plan import Cell, Plan
+from roto.olympiad.results import cell_statistics, lead_measure
 from roto.olympiad.stats import difference_ci, paired_difference_ci
 from roto.robots import ROBOTS
 from roto.tasks import TASKS, get_task
@@ -299,100 +292,3 @@ def variants_table(summaries: list[dict], baseline: str, plan: Plan | None = Non
                 cells += ["(baseline)", "", ""] if row[2] == baseline else _against(seeds, base)
                 lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
-
-
-def _variants(summaries: list[dict], plan: Plan | None, options: dict[str, str]) -> str:
-    if "baseline" not in options:
-        raise ValueError(
-            "a variants block names its baseline variant: <!-- roto results: variants SOURCES baseline=VARIANT -->"
-        )
-    return variants_table(summaries, options["baseline"], plan)
-
-
-TABLES: dict[str, Callable[[list[dict], Plan | None, dict[str, str]], str]] = {
-    "bounce": lambda summaries, plan, options: task_table(summaries, "bounce", plan),
-    "baoding": lambda summaries, plan, options: task_table(summaries, "baoding", plan),
-    "overview": lambda summaries, plan, options: overview_table(summaries),
-    "orderings": lambda summaries, plan, options: orderings_table(summaries),
-    "seeds": lambda summaries, plan, options: seeds_table(summaries),
-    "variants": _variants,
-}
-"""The kinds of generated block a page may hold, each a table of its source's summaries."""
-BLOCK = re.compile(r"(<!-- roto results: (\S+) (\S+)((?: \w+=\S+)*) -->\n)(.*?)(<!-- /roto results -->)", re.DOTALL)
-OPTIONS = ("plan", "baseline")
-"""What a block's opening may set after its sources: ``plan=PLAN[,PLAN...]`` (the plans whose
-configs label the rows), ``baseline=VARIANT`` (the variants table's baseline)."""
-
-
-def joined_plans(names: str) -> Plan:
-    """The plans ``names`` (comma-separated names or files) as one whose variants are all of theirs,
-    so that rows from several studies each name their own config; ValueError where two of them
-    train a variant of the same name differently."""
-    plans = [load_plan(name) for name in names.split(",")]
-    variants = dict(plans[0].variants)
-    for plan in plans[1:]:
-        for name, variant in plan.variants.items():
-            if variants.setdefault(name, variant) != variant:
-                raise ValueError(f"plans {names!r} both have a variant {name!r}, trained differently; name one plan")
-    return dataclasses.replace(plans[0], variants=variants)
-
-
-def _options(opening: str, text: str) -> dict[str, str]:
-    """A block's ``key=value`` options; ValueError naming an unknown one."""
-    options = dict(item.split("=", 1) for item in text.split())
-    unknown = sorted(set(options) - set(OPTIONS))
-    if unknown:
-        raise ValueError(f"generated block {opening.strip()!r}: unknown option {unknown[0]!r}; valid: {list(OPTIONS)}")
-    return options
-
-
-def refresh_blocks(text: str, root: str | pathlib.Path) -> str:
-    """``text`` with every generated block's table made again from its source folders (relative to
-    ``root``, the repository; several joined by commas); ValueError naming an unknown kind or
-    option, or a folder without summaries."""
-
-    def table(match: re.Match) -> str:
-        opening, kind, source, options = match.group(1, 2, 3, 4)
-        if kind not in TABLES:
-            raise ValueError(f"generated block {opening.strip()!r}: unknown kind {kind!r}; valid: {sorted(TABLES)}")
-        options = _options(opening, options)
-        plan = joined_plans(options["plan"]) if "plan" in options else None
-        summaries = [s for folder in source.split(",") for s in read_summaries(pathlib.Path(root) / folder)]
-        return f"{opening}{TABLES[kind](summaries, plan, options)}\n{match.group(6)}"
-
-    return BLOCK.sub(table, text)
-
-
-OPENING = re.compile(r"^<!-- roto results:", re.MULTILINE)
-
-
-def check_blocks(text: str, page: str) -> int:
-    """How many generated blocks ``page`` (its ``text``) holds; ValueError naming the page when it
-    holds none, or the line of an opening that does not read as one (a typo in it) or of a block
-    not closed before the next block opens, where refreshing would leave a stale table unnoticed."""
-
-    def line(index: int) -> int:
-        return text.count("\n", 0, index) + 1
-
-    blocks = [match.span() for match in BLOCK.finditer(text)]
-    starts = {start for start, _ in blocks}
-    for index in (match.start() for match in OPENING.finditer(text)):
-        if index in starts:
-            continue
-        enclosing = [start for start, end in blocks if start < index < end]
-        if enclosing:
-            raise ValueError(
-                f"page {page!r}, line {line(enclosing[0])}: the generated block opened there has no "
-                f"'<!-- /roto results -->' before the next block opens, at line {line(index)}"
-            )
-        opening = text[index:].split("\n", 1)[0]
-        raise ValueError(
-            f"page {page!r}, line {line(index)}: {opening!r} does not open a generated block; write "
-            "'<!-- roto results: KIND SOURCE[ option=value ...] -->', the table, then '<!-- /roto results -->'"
-        )
-    if not blocks:
-        raise ValueError(
-            f"page {page!r} holds no generated block ('<!-- roto results: KIND SOURCE -->' ... "
-            "'<!-- /roto results -->'): nothing in it to refresh"
-        )
-    return len(blocks)

@@ -7,7 +7,7 @@ import pathlib
 
 import pytest
 
-from roto.olympiad.reference_tables import OPENING, check_blocks, refresh_blocks
+from roto.olympiad.page_blocks import OPENING, check_blocks, refresh_blocks
 from roto.olympiad.results import read_summaries
 from roto.olympiad.results_page import results_markdown
 
