@@ -8,7 +8,7 @@ import json
 import sys
 from collections.abc import Sequence
 
-from roto.cli_args import add_checkpoint_arg, add_env_args, add_touch_arg
+from roto.cli_args import add_checkpoint_arg, add_env_args, add_touch_arg, env_flags
 from roto.cli_demo import add_demo_parser
 from roto.cli_errors import check_output_path, error_exit, make_parents, quiet_on_closed_stdout
 from roto.cli_train import add_train_parser
@@ -40,18 +40,7 @@ def _cmd_list(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from roto.bench import run_bench
 
-    result = run_bench(
-        task=args.task,
-        robot=args.robot,
-        num_envs=args.num_envs,
-        threads=args.threads,
-        steps=args.steps,
-        obs_mode=args.obs_mode,
-        seed=args.seed,
-        backend=args.backend,
-        device=args.device,
-        touch=args.touch,
-    )
+    result = run_bench(task=args.task, robot=args.robot, steps=args.steps, obs_mode=args.obs_mode, **env_flags(args))
     if args.json:
         print(json.dumps(result))
     else:

@@ -29,6 +29,13 @@ def add_env_args(parser: argparse.ArgumentParser, num_envs: int) -> None:
     parser.add_argument("--headless", action="store_true", help="accepted for Isaac Lab compatibility; no effect")
 
 
+def env_flags(args: argparse.Namespace) -> dict:
+    """The env flags of ``add_env_args`` and ``add_touch_arg`` a command was given, as the keyword
+    arguments of the env builders (num_envs, seed, backend, device, threads, touch)."""
+    names = ("num_envs", "seed", "backend", "device", "threads", "touch")
+    return {name: getattr(args, name) for name in names}
+
+
 def add_checkpoint_arg(parser: argparse.ArgumentParser) -> None:
     """``--checkpoint``, required, of the commands that load a trained policy (eval, play)."""
     parser.add_argument(

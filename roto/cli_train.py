@@ -7,7 +7,7 @@ import argparse
 import json
 import sys
 
-from roto.cli_args import add_env_args, add_touch_arg, options_given
+from roto.cli_args import add_env_args, add_touch_arg, env_flags, options_given
 from roto.cli_errors import check_output_path
 from roto.rl.config_help import HelpConfigAction
 from roto.value_checks import check_count
@@ -43,16 +43,8 @@ def _cmd_train(args: argparse.Namespace) -> int:
         trainer = Trainer.resume(args.resume, args.steps, wandb_project=wandb_project, threads=threads)
     else:
         # the env flags are shorthand for env.* overrides, which win over them; all checked before anything is written
-        flags = dict(
-            num_envs=args.num_envs,
-            seed=args.seed,
-            backend=args.backend,
-            device=args.device,
-            threads=args.threads,
-            touch=args.touch,
-        )
         steps = args.steps if args.steps is not None else DEFAULT_STEPS
-        spec = build_run_spec(args.task, args.robot, args.obs, args.agent_cfg, args.overrides, steps, **flags)
+        spec = build_run_spec(args.task, args.robot, args.obs, args.agent_cfg, args.overrides, steps, **env_flags(args))
         run_dir = args.run_dir or pathlib.Path("runs") / (
             f"{spec.env.task}_{spec.env.robot}_{args.obs}" + f"/{time.strftime('%Y%m%d-%H%M%S')}_seed{spec.env.seed}"
         )

@@ -16,11 +16,9 @@ import dataclasses
 from collections.abc import Mapping
 from typing import Any
 
+from roto.envs.aids.round_swaps import ARMED_METRIC
 from roto.envs.aids.settings import AidsConfig
 from roto.rl.run_spec import RunSpec
-
-ARMED_METRIC = "train/round_swaps_armed"
-"""1 once the armed round swaps have armed, 0 until then (logged by ``ArmedRoundSwaps.metrics``)."""
 
 NEVER_ARMED_LABEL = "round_swaps (never armed)"
 """The aid's name in tables and manifests for a run whose round swaps never armed."""

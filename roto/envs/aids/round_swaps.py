@@ -19,6 +19,9 @@ from roto.envs.aids.episode_mean import fold_ended_episodes
 from roto.envs.aids.protocol import AidHost, StepContext, TrainingAid
 from roto.envs.aids.settings import RoundSwapsSettings
 
+ARMED_METRIC = "train/round_swaps_armed"
+"""The training scalar of ``ArmedRoundSwaps``: 1 once armed, 0 until then."""
+
 
 class RoundSwaps(TrainingAid):
     """Sets the task parameters ``swap_min_turn`` and ``swap_first_paid`` once, when the env is built."""
@@ -55,7 +58,7 @@ class ArmedRoundSwaps(TrainingAid):
         self._apply()
 
     def metrics(self) -> dict[str, torch.Tensor]:
-        return {"train/round_swaps_armed": self.armed.to(torch.float64)}
+        return {ARMED_METRIC: self.armed.to(torch.float64)}
 
     def state_dict(self) -> dict[str, Any]:
         return {"mean": self.mean.clone(), "armed": self.armed.clone()}
