@@ -1,8 +1,9 @@
 """A markdown page's generated blocks (docs/results.md, the README, experiments' pages): each
-between ``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN[,PLAN...]] [baseline=VARIANT] -->``
-and ``<!-- /roto results -->``, a table of ``roto.olympiad.reference_tables`` made from the cell
-summaries in its source folders. ``refresh_blocks`` makes every block's table again;
-``check_blocks`` finds an opening that does not read as one, or a block left open.
+between ``<!-- roto results: KIND SOURCE[,SOURCE...] [plan=PLAN[,PLAN...]] [names=NAME[,NAME...]]
+[baseline=VARIANT] -->`` and ``<!-- /roto results -->``, a table of
+``roto.olympiad.reference_tables`` made from the cell summaries in its source folders.
+``refresh_blocks`` makes every block's table again; ``check_blocks`` finds an opening that does
+not read as one, or a block left open.
 """
 
 from __future__ import annotations
@@ -13,7 +14,14 @@ import re
 from collections.abc import Callable
 
 from roto.olympiad.plan import Plan, load_plan
-from roto.olympiad.reference_tables import orderings_table, overview_table, seeds_table, task_table, variants_table
+from roto.olympiad.reference_tables import (
+    config_label,
+    orderings_table,
+    overview_table,
+    seeds_table,
+    task_table,
+    variants_table,
+)
 from roto.olympiad.results import read_summaries
 
 
@@ -35,9 +43,11 @@ TABLES: dict[str, Callable[[list[dict], Plan | None, dict[str, str]], str]] = {
 }
 """The kinds of generated block a page may hold, each a table of its source's summaries."""
 BLOCK = re.compile(r"(<!-- roto results: (\S+) (\S+)((?: \w+=\S+)*) -->\n)(.*?)(<!-- /roto results -->)", re.DOTALL)
-OPTIONS = ("plan", "baseline")
+OPTIONS = ("plan", "names", "baseline")
 """What a block's opening may set after its sources: ``plan=PLAN[,PLAN...]`` (the plans whose
-configs label the rows), ``baseline=VARIANT`` (the variants table's baseline)."""
+configs label the rows), ``names=NAME[,NAME...]`` (one per source: the variant name its cells
+show under, so that two studies' cells of one variant name stand side by side; ``plan=`` then
+names each source's own plan), ``baseline=VARIANT`` (the variants table's baseline)."""
 
 
 def joined_plans(names: str) -> Plan:
@@ -51,6 +61,32 @@ def joined_plans(names: str) -> Plan:
             if variants.setdefault(name, variant) != variant:
                 raise ValueError(f"plans {names!r} both have a variant {name!r}, trained differently; name one plan")
     return dataclasses.replace(plans[0], variants=variants)
+
+
+def named_summaries(root: str | pathlib.Path, folders: list[str], names: str, plans: str | None) -> list[dict]:
+    """The summaries of each of ``folders`` (relative to ``root``) under the variant name ``names``
+    gives it (one per folder, comma-separated), each labelled with the config its folder's plan
+    trains it with (``plans``, one per folder; without, the label its summary records) and keeping
+    only the cells of the variant that plan trains: a study whose cells share their variant's name
+    with another's (the benchmark's ``ppo``) is set beside it under a name of its own. ValueError
+    where the counts differ or a folder holds cells of more than one variant."""
+    names_list = names.split(",")
+    plan_list = [load_plan(name) for name in plans.split(",")] if plans else [None] * len(folders)
+    if not len(names_list) == len(plan_list) == len(folders):
+        raise ValueError(
+            f"names={names!r}{f' and plan={plans!r}' if plans else ''} must name one for each of the "
+            f"{len(folders)} sources {','.join(folders)!r}"
+        )
+    named = []
+    for folder, name, plan in zip(folders, names_list, plan_list, strict=True):
+        kept = [s for s in read_summaries(pathlib.Path(root) / folder) if plan is None or s["variant"] in plan.variants]
+        variants = sorted({s["variant"] for s in kept})
+        if len(variants) > 1:
+            raise ValueError(f"source {folder!r} holds cells of variants {variants}: names= gives a folder one name")
+        for s in kept:
+            agent = {**(s.get("agent") or {}), "label": config_label(s, plan)}
+            named.append({**s, "variant": name, "agent": agent})
+    return named
 
 
 def _options(opening: str, text: str) -> dict[str, str]:
@@ -72,8 +108,11 @@ def refresh_blocks(text: str, root: str | pathlib.Path) -> str:
         if kind not in TABLES:
             raise ValueError(f"generated block {opening.strip()!r}: unknown kind {kind!r}; valid: {sorted(TABLES)}")
         options = _options(opening, options)
-        plan = joined_plans(options["plan"]) if "plan" in options else None
-        summaries = [s for folder in source.split(",") for s in read_summaries(pathlib.Path(root) / folder)]
+        if "names" in options:
+            summaries, plan = named_summaries(root, source.split(","), options["names"], options.get("plan")), None
+        else:
+            plan = joined_plans(options["plan"]) if "plan" in options else None
+            summaries = [s for folder in source.split(",") for s in read_summaries(pathlib.Path(root) / folder)]
         return f"{opening}{TABLES[kind](summaries, plan, options)}\n{match.group(6)}"
 
     return BLOCK.sub(table, text)

@@ -5,7 +5,7 @@ import pytest
 from roto.cli import main
 from roto.olympiad.page_blocks import check_blocks, refresh_blocks
 from roto.olympiad.reference_tables import overview_table
-from tests.olympiad.test_reference_tables import SUMMARIES, VARIANT_SUMMARIES, write_folder
+from tests.olympiad.test_reference_tables import SUMMARIES, VARIANT_SUMMARIES, baoding, write_folder
 
 
 def test_pages_refresh_their_generated_blocks_from_one_or_more_folders(tmp_path, monkeypatch, capsys):
@@ -66,7 +66,7 @@ def test_a_variants_block_needs_its_baseline_and_known_options(tmp_path):
     assert "old" not in fresh and "| baoding | shadow | blind | bank |" in fresh
     with pytest.raises(ValueError, match="names its baseline variant"):
         refresh_blocks("<!-- roto results: variants s -->\n<!-- /roto results -->\n", tmp_path)
-    with pytest.raises(ValueError, match=r"unknown option 'baseln'; valid: \['plan', 'baseline'\]"):
+    with pytest.raises(ValueError, match=r"unknown option 'baseln'; valid: \['plan', 'names', 'baseline'\]"):
         refresh_blocks("<!-- roto results: variants s baseln=base -->\n<!-- /roto results -->\n", tmp_path)
 
 
@@ -103,3 +103,32 @@ def test_a_block_labels_each_variant_from_whichever_of_its_plans_trains_it(tmp_p
         refresh_blocks(
             f"<!-- roto results: variants s plan={one},{clash} baseline=base -->\n<!-- /roto results -->\n", tmp_path
         )
+
+
+def test_two_studies_whose_cells_share_a_variant_name_stand_side_by_side_under_names_of_their_own(tmp_path):
+    """The benchmark's cells and a study's retraining of them are both ``ppo``: ``names=`` gives each
+    folder's cells a name, so the variants table pairs them seed by seed, each row labelled from its
+    own folder's plan."""
+    write_folder(tmp_path / "recipe", [baoding("base", s, r, r) for s, r in ((0, 10.0), (1, 12.0), (2, 14.0))])
+    write_folder(tmp_path / "study", [baoding("base", s, r, r) for s, r in ((0, 11.0), (1, 11.0), (2, 16.0), (3, 9.0))])
+    one = plan_file(tmp_path / "one.yaml", {"base": "baoding_cpu"})
+    two = plan_file(tmp_path / "two.yaml", {"base": "baoding_cpu_v1"})
+    text = (
+        f"<!-- roto results: variants recipe,study plan={one},{two} names=with,without baseline=with -->\n"
+        "<!-- /roto results -->\n"
+    )
+    rows = [line.split(" | ") for line in refresh_blocks(text, tmp_path).splitlines() if line.startswith("| baoding")]
+    assert [(row[3], row[4], row[5]) for row in rows] == [
+        ("with", "`baoding_cpu`", "0, 1, 2"),
+        ("without", "`baoding_cpu_v1`", "0, 1, 2, 3"),
+    ]
+    # paired on seeds 0-2: +1, -1, +2 -> +0.7; seed 3 has no pair
+    assert rows[1][9] == "0, 1, 2" and rows[1][10].startswith("+0.7 [") and rows[1][11] == "2 / 1 |"
+    without_plans = text.replace(f" plan={one},{two}", "")
+    labels = [line.split(" | ")[4] for line in refresh_blocks(without_plans, tmp_path).splitlines()[3:-1]]
+    assert labels == ["`cfg_base`", "`cfg_base`"]  # the label each summary records
+    with pytest.raises(ValueError, match=r"names='with' must name one for each of the 2 sources 'recipe,study'"):
+        refresh_blocks(without_plans.replace("names=with,without", "names=with"), tmp_path)
+    write_folder(tmp_path / "mixed", VARIANT_SUMMARIES)
+    with pytest.raises(ValueError, match=r"source 'mixed' holds cells of variants \['bank', 'base', 'other_seeds'\]"):
+        refresh_blocks(without_plans.replace("recipe,study", "recipe,mixed"), tmp_path)
