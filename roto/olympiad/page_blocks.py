@@ -63,23 +63,23 @@ def joined_plans(names: str) -> Plan:
     return dataclasses.replace(plans[0], variants=variants)
 
 
-def named_summaries(root: str | pathlib.Path, folders: list[str], names: str, plans: str | None) -> list[dict]:
-    """The summaries of each of ``folders`` (relative to ``root``) under the variant name ``names``
-    gives it (one per folder, comma-separated), each labelled with the config its folder's plan
-    trains it with (``plans``, one per folder; without, the label its summary records) and keeping
-    only the cells of the variant that plan trains: a study whose cells share their variant's name
-    with another's (the benchmark's ``ppo``) is set beside it under a name of its own. ValueError
-    where the counts differ or a folder holds cells of more than one variant."""
+def named_summaries(sources: dict[str, list[dict]], names: str, plans: str | None) -> list[dict]:
+    """The summaries of each source folder (``sources``: folder -> its summaries) under the variant
+    name ``names`` gives it (one per folder, comma-separated), each labelled with the config its
+    folder's plan trains it with (``plans``, one per folder; without, the label its summary records)
+    and keeping only the cells of the variant that plan trains: a study whose cells share their
+    variant's name with another's (the benchmark's ``ppo``) is set beside it under a name of its
+    own. ValueError where the counts differ or a folder holds cells of more than one variant."""
     names_list = names.split(",")
-    plan_list = [load_plan(name) for name in plans.split(",")] if plans else [None] * len(folders)
-    if not len(names_list) == len(plan_list) == len(folders):
+    plan_list = [load_plan(name) for name in plans.split(",")] if plans else [None] * len(sources)
+    if not len(names_list) == len(plan_list) == len(sources):
         raise ValueError(
             f"names={names!r}{f' and plan={plans!r}' if plans else ''} must name one for each of the "
-            f"{len(folders)} sources {','.join(folders)!r}"
+            f"{len(sources)} sources {','.join(sources)!r}"
         )
     named = []
-    for folder, name, plan in zip(folders, names_list, plan_list, strict=True):
-        kept = [s for s in read_summaries(pathlib.Path(root) / folder) if plan is None or s["variant"] in plan.variants]
+    for (folder, summaries), name, plan in zip(sources.items(), names_list, plan_list, strict=True):
+        kept = [s for s in summaries if plan is None or s["variant"] in plan.variants]
         variants = sorted({s["variant"] for s in kept})
         if len(variants) > 1:
             raise ValueError(f"source {folder!r} holds cells of variants {variants}: names= gives a folder one name")
@@ -108,11 +108,12 @@ def refresh_blocks(text: str, root: str | pathlib.Path) -> str:
         if kind not in TABLES:
             raise ValueError(f"generated block {opening.strip()!r}: unknown kind {kind!r}; valid: {sorted(TABLES)}")
         options = _options(opening, options)
+        sources = {folder: read_summaries(pathlib.Path(root) / folder) for folder in source.split(",")}
         if "names" in options:
-            summaries, plan = named_summaries(root, source.split(","), options["names"], options.get("plan")), None
+            summaries, plan = named_summaries(sources, options["names"], options.get("plan")), None
         else:
             plan = joined_plans(options["plan"]) if "plan" in options else None
-            summaries = [s for folder in source.split(",") for s in read_summaries(pathlib.Path(root) / folder)]
+            summaries = [s for folder_summaries in sources.values() for s in folder_summaries]
         return f"{opening}{TABLES[kind](summaries, plan, options)}\n{match.group(6)}"
 
     return BLOCK.sub(table, text)
